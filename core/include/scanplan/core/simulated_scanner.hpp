@@ -1,0 +1,27 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <random>
+
+#include "scanplan/core/point_cloud.hpp"
+#include "scanplan/core/pose.hpp"
+#include "scanplan/core/ray_caster.hpp"
+#include "scanplan/core/scanner_model.hpp"
+
+namespace scanplan {
+
+// Called with the fraction of the rotation done, in [0, 1]; returning false aborts the scan.
+using ScanProgressFn = std::function<bool(double fraction)>;
+
+// One full turn of the rotation stage at `true_pose`. Points are in the robot frame (origin on
+// the ground under the scanner, x forward, z up); sky and out-of-range beams give no point.
+// The same seed gives the same scan.
+PointCloud simulate_scan(const RayCaster& caster, const ScannerConfig& config,
+                         const Pose& true_pose, std::uint64_t seed,
+                         const ScanProgressFn& progress = {});
+
+// The pose the robot would report at `truth`: x, y, z and yaw disturbed, roll/pitch exact.
+Pose reported_pose(const Pose& truth, const PoseNoise& noise, std::mt19937_64& rng);
+
+}  // namespace scanplan

@@ -1,0 +1,12 @@
+#pragma once
+
+// Topic names (DESIGN.md "DDS"): ROS-typed topics carry the ROS 2 `rt/` prefix so that a
+// ROS 2 node on rmw_cyclonedds sees them as /scanner/points etc.
+namespace scanplan::topics {
+
+inline constexpr const char* kPoints = "rt/scanner/points";
+inline constexpr const char* kPose = "rt/scanner/pose";
+inline constexpr const char* kScanProgress = "scanplan_ScanProgress";
+inline constexpr const char* kScanCommand = "scanplan_ScanCommand";
+
+}  // namespace scanplan::topics

@@ -1,0 +1,120 @@
+#include "api.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include "http/http_error.hpp"
+
+namespace scanplan::server {
+
+using http::HttpError;
+using http::Request;
+using http::Response;
+using nlohmann::json;
+
+namespace {
+
+json vec3(const Eigen::Vector3f& v) { return json::array({v.x(), v.y(), v.z()}); }
+
+json pose_json(const Pose& p) {
+  return {{"x", p.x}, {"y", p.y}, {"z", p.z}, {"yaw_deg", rad2deg(p.yaw)}};
+}
+
+std::string iso_time(std::chrono::system_clock::time_point t) {
+  const std::time_t tt = std::chrono::system_clock::to_time_t(t);
+  std::tm tm{};
+  gmtime_r(&tt, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+}  // namespace
+
+Api::Api(ScanStore& store, DdsLink& dds, const Auth& auth, std::string session_dir)
+    : store_(store),
+      dds_(dds),
+      auth_(auth),
+      session_dir_(std::move(session_dir)),
+      started_(std::chrono::system_clock::now()) {}
+
+void Api::install(http::Router& router) {
+  router.add("GET", "/api/v1/health", [this](const Request&, const auto&) { return health(); });
+  router.add("GET", "/api/v1/session", [this](const Request& r, const auto&) {
+    require(r, Role::kViewer);
+    return session();
+  });
+  router.add("GET", "/api/v1/map.drc", [this](const Request& r, const auto&) {
+    require(r, Role::kViewer);
+    return map_drc(r);
+  });
+  router.add("POST", "/api/v1/scan", [this](const Request& r, const auto&) {
+    require(r, Role::kOperator);
+    return request_scan(r);
+  });
+}
+
+void Api::require(const Request& request, Role needed) const {
+  const Role role = auth_.role_of(request);
+  if (role == Role::kNone) {
+    throw HttpError(401, "unauthorized",
+                    "a valid token is required: send 'Authorization: Bearer <token>'");
+  }
+  if (needed == Role::kOperator && role != Role::kOperator) {
+    throw HttpError(403, "forbidden", "this action needs an operator token; yours is a viewer's");
+  }
+}
+
+Response Api::health() const {
+  return Response::json(200, {{"status", "ok"}, {"bridges", dds_.connected_bridges()}});
+}
+
+Response Api::session() const {
+  const auto scans = store_.scans();
+  json robots = json::object();
+  for (const auto& [id, s] : store_.robot_states()) {
+    robots[id] = {{"command_id", s.command_id},
+                  {"state", s.state},
+                  {"fraction", s.fraction},
+                  {"message", s.message}};
+  }
+  json j = {{"session_dir", session_dir_},
+            {"started", iso_time(started_)},
+            {"scans", scans.size()},
+            {"points", store_.point_count()},
+            {"bridges", dds_.connected_bridges()},
+            {"robots", robots}};
+  if (!scans.empty()) {
+    const Bounds3 b = store_.bounds();
+    j["bounds"] = {{"min", vec3(b.min)}, {"max", vec3(b.max)}};
+    j["last_scan"] = {{"id", scans.back().id},
+                      {"robot", scans.back().robot_id},
+                      {"points", scans.back().points},
+                      {"pose", pose_json(scans.back().pose)}};
+  }
+  return Response::json(200, j);
+}
+
+Response Api::map_drc(const Request&) const {
+  const auto encoded = store_.encoded_map();
+  if (!encoded) {
+    Response empty;
+    empty.status = 204;
+    return empty;
+  }
+  Response r = Response::bytes(*encoded, "application/octet-stream");
+  r.set_header("Cache-Control", "no-store");
+  return r;
+}
+
+Response Api::request_scan(const Request& request) {
+  std::string robot;
+  if (const auto it = request.query.find("robot"); it != request.query.end()) robot = it->second;
+  try {
+    const std::uint32_t id = dds_.request_scan(robot);
+    return Response::json(202, {{"command_id", id}, {"robot", robot.empty() ? "*" : robot}});
+  } catch (const NoScannerError& e) {
+    throw HttpError(503, "no_scanner", e.what());
+  }
+}
+
+}  // namespace scanplan::server

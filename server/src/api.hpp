@@ -1,0 +1,36 @@
+#pragma once
+
+#include <chrono>
+#include <string>
+
+#include "auth.hpp"
+#include "dds_link.hpp"
+#include "http/router.hpp"
+#include "scan_store.hpp"
+
+namespace scanplan::server {
+
+// The REST API (DESIGN.md "REST"): handlers translate HTTP to calls on the store and the DDS
+// link and back; they hold no state of their own beyond the session's start time.
+class Api {
+ public:
+  Api(ScanStore& store, DdsLink& dds, const Auth& auth, std::string session_dir);
+  void install(http::Router& router);
+
+ private:
+  // Throws HttpError 401/403 unless the request carries a token with at least `needed`.
+  void require(const http::Request& request, Role needed) const;
+
+  http::Response health() const;
+  http::Response session() const;
+  http::Response map_drc(const http::Request& request) const;
+  http::Response request_scan(const http::Request& request);
+
+  ScanStore& store_;
+  DdsLink& dds_;
+  const Auth& auth_;
+  std::string session_dir_;
+  std::chrono::system_clock::time_point started_;
+};
+
+}  // namespace scanplan::server

@@ -1,0 +1,47 @@
+#include "auth.hpp"
+
+#include <openssl/crypto.h>
+#include <openssl/rand.h>
+
+#include <stdexcept>
+
+namespace scanplan::server {
+namespace {
+
+// Compares without an early exit so response timing does not reveal how much of a guess
+// was right; the length is not secret.
+bool same_token(const std::string& a, std::string_view b) {
+  return !a.empty() && a.size() == b.size() && CRYPTO_memcmp(a.data(), b.data(), a.size()) == 0;
+}
+
+}  // namespace
+
+Auth::Auth(std::string operator_token, std::string viewer_token)
+    : operator_token_(std::move(operator_token)), viewer_token_(std::move(viewer_token)) {}
+
+Role Auth::role_of(const http::Request& request) const {
+  const auto header = request.header("Authorization");
+  if (!header) return Role::kNone;
+  constexpr std::string_view kBearer = "Bearer ";
+  if (header->size() <= kBearer.size() || header->substr(0, kBearer.size()) != kBearer) {
+    return Role::kNone;
+  }
+  const std::string_view token = header->substr(kBearer.size());
+  if (same_token(operator_token_, token)) return Role::kOperator;
+  if (same_token(viewer_token_, token)) return Role::kViewer;
+  return Role::kNone;
+}
+
+std::string Auth::random_token() {
+  unsigned char bytes[16];
+  if (RAND_bytes(bytes, sizeof bytes) != 1) throw std::runtime_error("no randomness for a token");
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  for (unsigned char b : bytes) {
+    out += kHex[b >> 4];
+    out += kHex[b & 15];
+  }
+  return out;
+}
+
+}  // namespace scanplan::server

@@ -1,0 +1,96 @@
+// scanplan-server: the operator workstation (DESIGN.md "Processes").
+#include <CLI/CLI.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+
+#include "api.hpp"
+#include "auth.hpp"
+#include "dds_link.hpp"
+#include "http/http_server.hpp"
+#include "http/router.hpp"
+#include "http/static_files.hpp"
+#include "scan_store.hpp"
+
+#ifndef SCANPLAN_DEFAULT_WEB_DIR
+#define SCANPLAN_DEFAULT_WEB_DIR "web/dist"
+#endif
+
+namespace {
+
+scanplan::http::HttpServer* g_server = nullptr;
+void on_signal(int) {
+  if (g_server) g_server->stop();
+}
+
+std::string env_or_empty(const char* name) {
+  const char* v = std::getenv(name);
+  return v ? v : "";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"scanplan-server: 3-D mapping workstation for search and rescue"};
+  std::string session_dir, listen = "127.0.0.1:8080", web_dir = SCANPLAN_DEFAULT_WEB_DIR;
+  std::uint32_t domain = 0;
+  app.add_option("--session", session_dir, "session directory")->required();
+  app.add_option("--listen", listen, "HTTP address host:port (port 0 picks a free one)")
+      ->capture_default_str();
+  app.add_option("--domain", domain, "DDS domain id")->capture_default_str();
+  app.add_option("--web", web_dir, "directory of the built web page")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  spdlog::set_default_logger(spdlog::stderr_color_mt("server"));
+
+  namespace http = scanplan::http;
+  namespace srv = scanplan::server;
+  try {
+    const auto colon = listen.rfind(':');
+    if (colon == std::string::npos) throw std::runtime_error("--listen must be host:port");
+    http::ServerConfig config;
+    config.host = listen.substr(0, colon);
+    const int port = std::stoi(listen.substr(colon + 1));
+    if (port < 0 || port > 65535) throw std::runtime_error("--listen port must be 0..65535");
+    config.port = static_cast<std::uint16_t>(port);
+    std::filesystem::create_directories(session_dir);
+
+    std::string operator_token = env_or_empty("SCANPLAN_OPERATOR_TOKEN");
+    const bool generated = operator_token.empty();
+    if (generated) operator_token = srv::Auth::random_token();
+    const srv::Auth auth(operator_token, env_or_empty("SCANPLAN_VIEWER_TOKEN"));
+
+    srv::ScanStore store;
+    srv::DdsLink dds(domain, store);
+    srv::Api api(store, dds, auth, session_dir);
+    http::Router router([](std::string_view msg) { spdlog::error("{}", msg); });
+    api.install(router);
+    const http::StaticFiles files(web_dir);
+    router.set_fallback([&files](const http::Request& r, const http::Router::Params&) {
+      return files.serve(r);
+    });
+
+    http::HttpServer server(config, [&router](const http::Request& r) { return router.route(r); });
+    server.start();
+    dds.start();
+    g_server = &server;
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+    std::signal(SIGPIPE, SIG_IGN);
+
+    const std::string url = "http://" + config.host + ":" + std::to_string(server.port()) + "/";
+    std::cout << "scanplan-server listening on " << url << std::endl;
+    if (generated) std::cout << "operator link: " << url << "?token=" << operator_token << std::endl;
+    server.run();
+    g_server = nullptr;
+    dds.stop();
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
+  spdlog::info("stopped");
+  return 0;
+}

@@ -1,0 +1,58 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "scanplan/core/point_cloud.hpp"
+#include "scanplan/core/pose.hpp"
+
+namespace scanplan::server {
+
+struct ScanRecord {
+  std::uint64_t id = 0;
+  std::string robot_id;
+  Pose pose;  // where the scan was placed in the map frame
+  std::int64_t stamp_ns = 0;
+  std::size_t points = 0;
+};
+
+// What the session knows of one robot's current scan.
+struct RobotScanState {
+  std::uint32_t command_id = 0;
+  std::string state = "idle";  // idle, scanning, done, failed
+  float fraction = 0;
+  std::string message;
+};
+
+// The scans of this session, in the map frame, plus the map's Draco encoding, rebuilt off the
+// network thread each time a scan lands so that serving the map never waits on the encoder.
+class ScanStore {
+ public:
+  // `cloud` is in the scanner's robot frame; `pose` places it in the map frame.
+  ScanRecord add(const std::string& robot_id, const Pose& pose, std::int64_t stamp_ns,
+                 const PointCloud& cloud);
+
+  std::vector<ScanRecord> scans() const;
+  std::size_t scan_count() const;
+  std::size_t point_count() const;
+  Bounds3 bounds() const;
+  // Null while the map is empty.
+  std::shared_ptr<const std::string> encoded_map() const;
+
+  void set_robot_state(const std::string& robot_id, RobotScanState state);
+  std::map<std::string, RobotScanState> robot_states() const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<ScanRecord> scans_;
+  PointCloud map_;
+  std::shared_ptr<const std::string> encoded_;
+  std::map<std::string, RobotScanState> robots_;
+  std::mutex encode_mutex_;  // one encoder run at a time; readers keep the previous result
+};
+
+}  // namespace scanplan::server

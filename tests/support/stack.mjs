@@ -1,0 +1,114 @@
+// Starts a real scanplan-bridge + scanplan-server pair for a process-level test: DDS on
+// loopback in the test's own domain, HTTP on an ephemeral port, a session in a temp directory.
+import { spawn } from 'node:child_process';
+import { mkdtempSync, readFileSync, writeFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { randomBytes } from 'node:crypto';
+
+const env = process.env;
+
+export const loopbackDds =
+  '<CycloneDDS><Domain Id="any"><General><Interfaces>' +
+  '<NetworkInterface address="127.0.0.1" multicast="true"/>' +
+  '</Interfaces></General></Domain></CycloneDDS>';
+
+export function requireEnv(name) {
+  const v = env[name];
+  if (!v) throw new Error(`${name} is not set: run this test through ctest (make test)`);
+  return v;
+}
+
+// A copy of a sample world with overrides, e.g. exact poses for a test that checks geometry.
+export function worldVariant(dir, sampleName, overrides) {
+  const src = join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples', 'worlds', sampleName);
+  const world = { ...JSON.parse(readFileSync(src, 'utf8')), ...overrides };
+  const file = join(dir, sampleName);
+  writeFileSync(file, JSON.stringify(world));
+  return { file, world };
+}
+
+function startProcess(cmd, args, extraEnv, name) {
+  const child = spawn(cmd, args, {
+    env: { ...env, CYCLONEDDS_URI: loopbackDds, ...extraEnv },
+    stdio: ['ignore', 'pipe', 'pipe'],
+  });
+  child.log = '';
+  const keep = (chunk) => {
+    child.log += chunk.toString();
+    if (child.log.length > 200_000) child.log = child.log.slice(-100_000);
+  };
+  child.stdout.on('data', keep);
+  child.stderr.on('data', keep);
+  child.exited = new Promise((resolve) => child.on('exit', (code, signal) => resolve({ code, signal })));
+  child.label = name;
+  return child;
+}
+
+async function waitFor(what, fn, timeoutMs, procs = []) {
+  const deadline = Date.now() + timeoutMs;
+  for (;;) {
+    for (const p of procs) {
+      if (p.exitCode !== null) throw new Error(`${p.label} exited (${p.exitCode}) while waiting for ${what}:\n${p.log}`);
+    }
+    const v = await fn().catch(() => undefined);
+    if (v) return v;
+    if (Date.now() > deadline) {
+      throw new Error(`timed out waiting for ${what}\n` + procs.map((p) => `--- ${p.label}\n${p.log}`).join('\n'));
+    }
+    await new Promise((r) => setTimeout(r, 100));
+  }
+}
+
+export async function startStack({ world, timeScale = 600, seed = 1 } = {}) {
+  const dir = mkdtempSync(join(tmpdir(), 'scanplan-test-'));
+  const domain = requireEnv('SCANPLAN_TEST_DOMAIN');
+  const token = randomBytes(16).toString('hex');
+  const viewerToken = randomBytes(16).toString('hex');
+  const worldFile = world ?? join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples/worlds/yard.json');
+
+  const server = startProcess(
+    requireEnv('SCANPLAN_SERVER'),
+    ['--session', join(dir, 'session'), '--listen', '127.0.0.1:0', '--domain', domain,
+     '--web', requireEnv('SCANPLAN_WEB_DIR')],
+    { SCANPLAN_OPERATOR_TOKEN: token, SCANPLAN_VIEWER_TOKEN: viewerToken }, 'scanplan-server');
+  const bridge = startProcess(
+    requireEnv('SCANPLAN_BRIDGE'),
+    ['--world', worldFile, '--domain', domain, '--time-scale', String(timeScale), '--seed', String(seed)],
+    {}, 'scanplan-bridge');
+  const procs = [server, bridge];
+
+  const url = await waitFor('the server to listen',
+    async () => server.log.match(/listening on (http:\/\/[0-9.:]+)\//)?.[1], 15000, procs);
+
+  const api = async (method, path, { auth = token, body } = {}) => {
+    const headers = auth ? { Authorization: `Bearer ${auth}` } : {};
+    return fetch(url + path, { method, headers, body });
+  };
+
+  const stack = {
+    url, token, viewerToken, dir, server, bridge, api,
+    waitFor: (what, fn, timeoutMs = 60000) => waitFor(what, fn, timeoutMs, procs),
+    async stop() {
+      for (const p of procs) if (p.exitCode === null) p.kill('SIGTERM');
+      const results = await Promise.all(procs.map((p) => p.exited));
+      rmSync(dir, { recursive: true, force: true });
+      return results;
+    },
+  };
+  await stack.waitFor('the bridge to be matched on DDS', async () => {
+    const h = await (await api('GET', '/api/v1/health', { auth: null })).json();
+    return h.bridges >= 1;
+  }, 20000);
+  return stack;
+}
+
+// Asks for one scan and waits until the session holds `count` scans.
+export async function scanAndWait(stack, count) {
+  const r = await stack.api('POST', '/api/v1/scan');
+  if (r.status !== 202) throw new Error(`POST /api/v1/scan answered ${r.status}: ${await r.text()}`);
+  return stack.waitFor(`scan ${count} in the session`, async () => {
+    const s = await (await stack.api('GET', '/api/v1/session')).json();
+    return s.scans >= count ? s : undefined;
+  });
+}

@@ -1,0 +1,94 @@
+#include <gtest/gtest.h>
+
+#include "scanplan/core/simulated_scanner.hpp"
+
+namespace scanplan {
+namespace {
+
+World flat_world() {
+  return parse_world(R"({"name": "flat", "bounds": {"min": [-100, -100], "max": [100, 100]},
+                         "ground": {"z": 0}, "objects": [], "start": [0, 0, 0]})",
+                     "flat.json");
+}
+
+TEST(RayCaster, GroundAndBoxHitsMatchGeometry) {
+  World w = flat_world();
+  w.boxes.push_back({{5, -1, 0}, {6, 1, 2}, 0, {255, 0, 0}});
+  const RayCaster rc(w);
+  const auto ground = rc.cast({0, 0, 1}, Eigen::Vector3d(1, 0, -1).normalized(), 0, 100);
+  ASSERT_TRUE(ground);
+  EXPECT_NEAR(ground->range, std::sqrt(2.0), 1e-9);
+  const auto box = rc.cast({0, 0, 1}, {1, 0, 0}, 0, 100);
+  ASSERT_TRUE(box);
+  EXPECT_NEAR(box->range, 5.0, 1e-9);
+  EXPECT_EQ(box->color, (Rgb{255, 0, 0}));
+  EXPECT_FALSE(rc.cast({0, 0, 1}, {0, 0, 1}, 0, 100)) << "the sky gives no return";
+  EXPECT_FALSE(rc.cast({0, 0, 1}, {1, 0, 0}, 0, 4.9)) << "beyond max range";
+}
+
+TEST(RayCaster, YawedBoxIsHitOnItsTurnedFace) {
+  World w = flat_world();
+  // A 2 m cube centred at (10, 0) turned 45°: its corner points at the origin, 10 − √2 away.
+  w.boxes.push_back({{9, -1, 0}, {11, 1, 2}, M_PI / 4, {0, 0, 255}});
+  const RayCaster rc(w);
+  const auto hit = rc.cast({0, 0, 1}, {1, 0, 0}, 0, 100);
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->range, 10 - std::sqrt(2.0), 1e-9);
+}
+
+TEST(SimulatedScanner, FlatPlaneGivesExpectedCountAndHeights) {
+  World w = flat_world();
+  w.scanner.range_noise_m = 0;
+  w.scanner.rotation_step_deg = 2.0;
+  w.scanner.vertical_step_deg = 1.0;
+  const PointCloud c = simulate_scan(RayCaster(w), w.scanner, w.start, 7);
+  // A beam at elevation e < 0 meets the ground at range h / sin(-e); it counts when that range is
+  // within [0.5, 80] m: h = 1 m gives e ≤ −0.7163° and e ≥ −90°. At 1° steps from −90° that is
+  // −90..−1 (90 elevations), each for 180 stage angles; the straight-down beam repeats per angle.
+  EXPECT_EQ(c.size(), 90u * 180u);
+  for (const auto& p : c.points) EXPECT_NEAR(p.z(), 0.0, 1e-4);
+}
+
+TEST(SimulatedScanner, SameSeedSameScanAndNoiseHasItsSpread) {
+  World w = flat_world();
+  w.scanner.rotation_step_deg = 5.0;
+  const RayCaster rc(w);
+  const PointCloud a = simulate_scan(rc, w.scanner, w.start, 3);
+  const PointCloud b = simulate_scan(rc, w.scanner, w.start, 3);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_TRUE(std::equal(a.points.begin(), a.points.end(), b.points.begin()));
+  // Straight-down beams hit at range 1 m: their z spread is the range noise.
+  double sum = 0, sum2 = 0;
+  int n = 0;
+  for (const auto& p : a.points) {
+    if (p.head<2>().norm() > 1e-3) continue;
+    sum += p.z();
+    sum2 += p.z() * p.z();
+    ++n;
+  }
+  ASSERT_GT(n, 50);
+  const double sd = std::sqrt(sum2 / n - (sum / n) * (sum / n));
+  EXPECT_NEAR(sd, w.scanner.range_noise_m, 0.004);
+}
+
+TEST(SimulatedScanner, ReportedPoseNoiseHasConfiguredSpread) {
+  PoseNoise noise;
+  std::mt19937_64 rng(11);
+  const Pose truth;
+  double sx = 0, sz = 0, syaw = 0;
+  constexpr int kDraws = 20000;
+  for (int i = 0; i < kDraws; ++i) {
+    const Pose p = reported_pose(truth, noise, rng);
+    sx += p.x * p.x;
+    sz += p.z * p.z;
+    syaw += p.yaw * p.yaw;
+    ASSERT_EQ(p.roll, 0.0);
+    ASSERT_EQ(p.pitch, 0.0);
+  }
+  EXPECT_NEAR(std::sqrt(sx / kDraws), noise.xy_sigma_m, 0.03);
+  EXPECT_NEAR(std::sqrt(sz / kDraws), noise.z_sigma_m, 0.01);
+  EXPECT_NEAR(rad2deg(std::sqrt(syaw / kDraws)), noise.yaw_sigma_deg, 0.15);
+}
+
+}  // namespace
+}  // namespace scanplan
