@@ -3,106 +3,124 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
 #include <thread>
 
-#include "ros2_types.h"
-#include "scanplan.h"
+#include "scanplan/core/image_codec.hpp"
+#include "scanplan/core/panorama_renderer.hpp"
 #include "scanplan/core/simulated_scanner.hpp"
-#include "scanplan/msgs/pointcloud2.hpp"
-#include "scanplan/msgs/pose_stamped.hpp"
-#include "scanplan/msgs/topics.hpp"
 
 namespace scanplan::bridge {
-namespace {
-
-std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-}  // namespace
 
 SimulatedRobot::SimulatedRobot(World world, dds::Participant& participant, BridgeOptions options)
     : world_(std::move(world)),
       caster_(world_),
-      participant_(participant),
+      traversability_(world_, caster_),
       options_(std::move(options)),
+      publisher_(participant, options_.robot_id),
+      commands_(participant, options_.robot_id),
       true_pose_(world_.start),
       pose_rng_(options_.seed) {
-  scan_cmd_reader_ = participant_.reader(scanplan_ScanCommand_desc, topics::kScanCommand,
-                                         dds::QosKind::kCommand);
-  points_writer_ = participant_.writer(sensor_msgs_msg_dds__PointCloud2__desc, topics::kPoints,
-                                       dds::QosKind::kScanData);
-  pose_writer_ = participant_.writer(geometry_msgs_msg_dds__PoseStamped__desc, topics::kPose,
-                                     dds::QosKind::kScanData);
-  progress_writer_ = participant_.writer(scanplan_ScanProgress_desc, topics::kScanProgress,
-                                         dds::QosKind::kStatus);
+  reported_ = reported_pose(true_pose_, world_.pose_noise, pose_rng_);
+}
+
+bool SimulatedRobot::pass_time(double simulated_s, const std::atomic<bool>& stop) const {
+  if (options_.time_scale <= 0) return !stop;
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point until =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(simulated_s / options_.time_scale));
+  // Short naps so that a stop request is noticed mid-drive.
+  while (!stop && Clock::now() < until) {
+    std::this_thread::sleep_until(std::min(until, Clock::now() + std::chrono::milliseconds(50)));
+  }
+  return !stop;
 }
 
 void SimulatedRobot::run(const std::atomic<bool>& stop) {
-  dds::ReadWaiter waiter(participant_.handle(), {scan_cmd_reader_});
   spdlog::info("robot '{}' ready in world '{}' at ({:.2f}, {:.2f}), waiting for commands",
                options_.robot_id, world_.name, true_pose_.x, true_pose_.y);
+  auto last_status = std::chrono::steady_clock::time_point{};
   while (!stop) {
-    if (!waiter.wait(std::chrono::milliseconds(200))) continue;
-    std::vector<std::uint32_t> commands;
-    dds::take_all<scanplan_ScanCommand>(scan_cmd_reader_, [&](const scanplan_ScanCommand& c) {
-      const std::string target = c.robot_id ? c.robot_id : "";
-      if (target.empty() || target == options_.robot_id) commands.push_back(c.command_id);
-    });
-    for (const std::uint32_t id : commands) {
+    // A periodic idle status lets a server that started later learn where the robot is.
+    if (std::chrono::steady_clock::now() - last_status > std::chrono::seconds(1)) {
+      publisher_.status(0, "idle", reported_);
+      last_status = std::chrono::steady_clock::now();
+    }
+    for (const Command& c : commands_.wait(std::chrono::milliseconds(200))) {
       if (stop) break;
-      scan(id, stop);
+      if (const auto* s = std::get_if<ScanRequest>(&c)) scan(s->command_id, stop);
+      if (const auto* m = std::get_if<MoveRequest>(&c)) move(*m, stop);
+      last_status = std::chrono::steady_clock::now();
     }
   }
-}
-
-void SimulatedRobot::publish_progress(std::uint32_t command_id, const std::string& state,
-                                      float fraction, const std::string& message) {
-  scanplan_ScanProgress p{};
-  p.robot_id = const_cast<char*>(options_.robot_id.c_str());
-  p.command_id = command_id;
-  p.state = const_cast<char*>(state.c_str());
-  p.fraction = fraction;
-  p.message = const_cast<char*>(message.c_str());
-  dds::check(dds_write(progress_writer_, &p), "publishing scan progress");
 }
 
 void SimulatedRobot::scan(std::uint32_t command_id, const std::atomic<bool>& stop) {
   spdlog::info("scan command {}: scanning", command_id);
-  publish_progress(command_id, "scanning", 0.0f, "");
+  publisher_.status(command_id, "scanning", reported_);
+  publisher_.progress(command_id, "scanning", 0.0f);
+  const ScannerConfig& cfg = world_.scanner;
   const auto started = std::chrono::steady_clock::now();
-  // The rotation stage takes scan_duration_s of simulated time; pacing the progress callback
-  // against the wall clock makes the operator's progress bar move as the real scanner would.
-  const double wall_duration_s =
-      options_.time_scale > 0 ? world_.scanner.scan_duration_s / options_.time_scale : 0.0;
   float last_reported = 0.0f;
+  // The rotation stage takes scan_duration_s of simulated time; pacing the progress callback
+  // against the wall clock makes the operator's progress bar move as the real scanner's would.
   const auto progress = [&](double fraction) {
-    const auto due = started + std::chrono::duration<double>(wall_duration_s * fraction);
-    std::this_thread::sleep_until(due);
+    if (options_.time_scale > 0) {
+      std::this_thread::sleep_until(started + std::chrono::duration<double>(
+                                                  cfg.scan_duration_s * fraction / options_.time_scale));
+    }
     if (fraction - last_reported >= 0.01 || fraction >= 1.0) {
       last_reported = static_cast<float>(fraction);
-      publish_progress(command_id, "scanning", last_reported, "");
+      publisher_.progress(command_id, "scanning", last_reported);
     }
     return !stop.load();
   };
   const std::uint64_t seed = options_.seed * 1000003u + scans_taken_++;
-  PointCloud cloud = simulate_scan(caster_, world_.scanner, true_pose_, seed, progress);
+  PointCloud cloud = simulate_scan(caster_, cfg, true_pose_, seed, progress);
   if (stop) {
-    publish_progress(command_id, "failed", last_reported, "the scanner was shut down mid-scan");
+    publisher_.progress(command_id, "failed", last_reported, "the scanner was shut down mid-scan");
     return;
   }
-  const Pose reported = reported_pose(true_pose_, world_.pose_noise, pose_rng_);
-  const std::int64_t stamp = now_ns();
-  // The pose goes first: the server pairs a scan with the pose of the same stamp.
-  dds::OwnedPoseStamped pose_msg;
-  dds::to_pose_stamped(reported, options_.robot_id + "/map", stamp, pose_msg);
-  dds::check(dds_write(pose_writer_, &pose_msg.msg), "publishing the scan pose");
-  const dds::PackedPointCloud2 points(cloud, options_.robot_id + "/scanner", stamp);
-  dds::check(dds_write(points_writer_, &points.msg()), "publishing the scan points");
-  publish_progress(command_id, "done", 1.0f, std::to_string(cloud.size()) + " points");
-  spdlog::info("scan command {}: published {} points", command_id, cloud.size());
+  // The laser sees no colour: the server colourises from the panorama.
+  cloud.colors.clear();
+  CameraShot shot{{}, PanoramaCamera::for_scanner(cfg)};
+  shot.jpeg = encode_jpeg(render_panorama(caster_, shot.camera, true_pose_), cfg.camera_jpeg_quality);
+  publisher_.scan(cloud, reported_, shot);
+  publisher_.progress(command_id, "done", 1.0f, std::to_string(cloud.size()) + " points");
+  publisher_.status(command_id, "idle", reported_);
+  spdlog::info("scan command {}: published {} points and a {}-byte panorama", command_id,
+               cloud.size(), shot.jpeg.size());
+}
+
+void SimulatedRobot::move(const MoveRequest& goal, const std::atomic<bool>& stop) {
+  const auto refuse = [&](const std::string& why) {
+    spdlog::warn("move command {} to ({:.2f}, {:.2f}) refused: {}", goal.command_id, goal.x, goal.y, why);
+    publisher_.status(goal.command_id, "refused", reported_, why);
+  };
+  if (!std::isfinite(goal.x) || !std::isfinite(goal.y) || !std::isfinite(goal.yaw_deg)) {
+    return refuse("the goal is not a finite position");
+  }
+  const auto goal_cell = traversability_.cell_of(goal.x, goal.y);
+  if (!goal_cell) return refuse("the goal lies outside the target region");
+  const auto reach = traversability_.reach_from(true_pose_.x, true_pose_.y, true_pose_.z);
+  if (!reach.reachable(*goal_cell)) {
+    return refuse(traversability_.surfaces(*goal_cell).empty()
+                      ? "the goal is inside an obstacle or under too low a ceiling"
+                      : "no drivable path leads to the goal (steps over 0.15 m or obstacles)");
+  }
+  const double distance = reach.distance_m[*goal_cell];
+  spdlog::info("move command {}: driving {:.1f} m to ({:.2f}, {:.2f})", goal.command_id, distance,
+               goal.x, goal.y);
+  publisher_.status(goal.command_id, "moving", reported_);
+  if (!pass_time(distance / options_.speed_mps, stop)) return;
+  true_pose_.x = goal.x;
+  true_pose_.y = goal.y;
+  true_pose_.z = reach.z[*goal_cell];
+  true_pose_.yaw = deg2rad(goal.yaw_deg);
+  reported_ = reported_pose(true_pose_, world_.pose_noise, pose_rng_);
+  publisher_.status(goal.command_id, "arrived", reported_,
+                    "drove " + std::to_string(static_cast<int>(std::lround(distance))) + " m");
 }
 
 }  // namespace scanplan::bridge

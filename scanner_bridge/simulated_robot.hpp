@@ -5,20 +5,23 @@
 #include <random>
 #include <string>
 
+#include "command_reader.hpp"
+#include "scanner_publisher.hpp"
 #include "scanplan/core/ray_caster.hpp"
 #include "scanplan/core/world.hpp"
-#include "scanplan/msgs/dds_participant.hpp"
+#include "scanplan/core/world_traversability.hpp"
 
 namespace scanplan::bridge {
 
 struct BridgeOptions {
   std::string robot_id = "robot1";
-  double time_scale = 1.0;  // simulated seconds per wall-clock second
+  double time_scale = 1.0;  // simulated seconds per wall-clock second; 0 runs without pauses
   std::uint64_t seed = 1;
+  double speed_mps = 0.5;  // driving speed over rough ground
 };
 
-// Stands for the scanner robot on DDS: answers each scan command with a simulated scan at the
-// robot's true pose, published with the pose the robot would report (true pose + noise).
+// Stands for the scanner robot on DDS in a simulated world: scans where it truly stands
+// (publishing the pose it would report, true pose + noise), and drives to goals it can reach.
 class SimulatedRobot {
  public:
   SimulatedRobot(World world, dds::Participant& participant, BridgeOptions options);
@@ -27,17 +30,20 @@ class SimulatedRobot {
 
  private:
   void scan(std::uint32_t command_id, const std::atomic<bool>& stop);
-  void publish_progress(std::uint32_t command_id, const std::string& state, float fraction,
-                        const std::string& message);
+  void move(const MoveRequest& goal, const std::atomic<bool>& stop);
+  // Sleeps for `simulated_s` of simulated time; false when stopped meanwhile.
+  bool pass_time(double simulated_s, const std::atomic<bool>& stop) const;
 
   World world_;
   RayCaster caster_;
-  dds::Participant& participant_;
+  WorldTraversability traversability_;
   BridgeOptions options_;
+  ScannerPublisher publisher_;
+  CommandReader commands_;
   Pose true_pose_;
+  Pose reported_;
   std::mt19937_64 pose_rng_;
   std::uint64_t scans_taken_ = 0;
-  dds_entity_t scan_cmd_reader_, points_writer_, pose_writer_, progress_writer_;
 };
 
 }  // namespace scanplan::bridge

@@ -5,7 +5,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ccache pkg-config clang-format curl
   cyclonedds-dev cyclonedds-tools
-  libeigen3-dev libdraco-dev nlohmann-json3-dev libcli11-dev libspdlog-dev libssl-dev
+  libeigen3-dev libdraco-dev libopencv-dev nlohmann-json3-dev libcli11-dev libspdlog-dev libssl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   nodejs npm chromium
 )

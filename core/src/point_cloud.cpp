@@ -3,6 +3,9 @@
 namespace scanplan {
 
 void PointCloud::append(const PointCloud& other) {
+  // An empty cloud has no colours to disagree with; without this its empty colour array
+  // would strip the colours from everything appended so far.
+  if (other.empty()) return;
   const bool keep_colors = has_colors() || empty();
   points.insert(points.end(), other.points.begin(), other.points.end());
   if (keep_colors && other.has_colors()) {

@@ -40,11 +40,12 @@ PackedPointCloud2::PackedPointCloud2(const PointCloud& cloud, const std::string&
   for (std::size_t i = 0; i < n; ++i) {
     std::uint8_t* p = data_.data() + i * kPointStep;
     std::memcpy(p, cloud.points[i].data(), 12);
-    // ROS packs colour as 0x00RRGGBB reinterpreted as a float32.
+    // ROS packs colour as 0x00RRGGBB reinterpreted as a float32; 0 stands for "not
+    // colourised yet" (a laser alone sees no colour).
     const std::uint32_t rgb = colored ? (std::uint32_t(cloud.colors[i][0]) << 16) |
                                             (std::uint32_t(cloud.colors[i][1]) << 8) |
                                             cloud.colors[i][2]
-                                      : 0xFFFFFFu;
+                                      : 0u;
     std::memcpy(p + 12, &rgb, 4);
   }
   msg_.header.stamp = to_stamp(stamp);
@@ -91,6 +92,7 @@ PointCloud unpack_pointcloud2(const sensor_msgs_msg_dds__PointCloud2_& msg) {
   }
   PointCloud cloud;
   cloud.reserve(count);
+  bool any_color = false;
   for (std::uint32_t row = 0; row < msg.height; ++row) {
     const std::uint8_t* base = msg.data._buffer + std::uint64_t(row) * msg.row_step;
     for (std::uint32_t col = 0; col < msg.width; ++col) {
@@ -98,15 +100,17 @@ PointCloud unpack_pointcloud2(const sensor_msgs_msg_dds__PointCloud2_& msg) {
       Eigen::Vector3f xyz;
       for (int a = 0; a < 3; ++a) std::memcpy(&xyz[a], p + off[a], 4);
       if (!xyz.allFinite()) continue;
-      Rgb c{255, 255, 255};
+      Rgb c{0, 0, 0};
       if (rgb_off >= 0) {
         std::uint32_t v;
         std::memcpy(&v, p + rgb_off, 4);
         c = {std::uint8_t(v >> 16), std::uint8_t(v >> 8), std::uint8_t(v)};
+        any_color |= (v & 0xFFFFFFu) != 0;
       }
       cloud.push_back(xyz, c);
     }
   }
+  if (!any_color) cloud.colors.clear();
   return cloud;
 }
 

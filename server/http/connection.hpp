@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <utility>
 
 #include "http/limits.hpp"
@@ -20,7 +21,11 @@ struct Connection {
 
   Connection(std::uint64_t id, UniqueFd fd, std::string peer, const Limits& limits,
              Clock::time_point now)
-      : id(id), fd(std::move(fd)), peer(std::move(peer)), parser(limits), last_activity(now),
+      : id(id),
+        fd(std::move(fd)),
+        peer(std::move(peer)),
+        parser(limits),
+        last_activity(now),
         deadline(now) {}
 
   bool has_output() const { return out_sent < out.size(); }
@@ -40,9 +45,9 @@ struct Connection {
   std::size_t out_sent = 0;
   std::size_t queued_responses = 0;  // responses appended since out was last drained
 
-  bool served_any = false;      // decides between header and idle timeout when nothing is pending
-  bool continue_sent = false;   // "100 Continue" already sent for the current request
-  bool head_timer = false;      // the header timeout is running for the current request
+  bool served_any = false;     // decides between header and idle timeout when nothing is pending
+  bool continue_sent = false;  // "100 Continue" already sent for the current request
+  bool head_timer = false;     // the header timeout is running for the current request
   Clock::time_point head_started;
 
   bool closing = false;    // no further requests are processed; close once out is written

@@ -47,7 +47,9 @@ constexpr std::chrono::milliseconds kAcceptPause{100};
 constexpr std::chrono::milliseconds kMaxSweepInterval{1000};
 constexpr std::string_view kContinue = "HTTP/1.1 100 Continue\r\n\r\n";
 
-std::string errno_text(int err) { return std::generic_category().message(err); }
+std::string errno_text(int err) {
+  return std::generic_category().message(err);
+}
 
 std::string endpoint_text(const std::string& host, std::uint16_t port) {
   const bool ipv6 = host.find(':') != std::string::npos;
@@ -69,13 +71,31 @@ std::string peer_text(const sockaddr_storage& addr) {
   return "unknown";
 }
 
+// Linux reports network errors already pending on a new connection through accept(2); they
+// concern that one client, and the listener is fine (accept(2), "Error handling").
+bool concerns_one_client(int err) {
+  switch (err) {
+    case ECONNABORTED:
+    case EPROTO:
+    case ENETDOWN:
+    case ENOPROTOOPT:
+    case EHOSTDOWN:
+    case ENONET:
+    case EHOSTUNREACH:
+    case EOPNOTSUPP:
+    case ENETUNREACH:
+      return true;
+    default:
+      return false;
+  }
+}
+
 bool has_close_token(const Response& response) {
   bool close = false;
   for (const Header& h : response.headers) {
     if (!ascii::iequals(h.name, "connection")) continue;
-    ascii::for_each_list_element(h.value, [&](std::string_view token) {
-      close = close || ascii::iequals(token, "close");
-    });
+    ascii::for_each_list_element(
+        h.value, [&](std::string_view token) { close = close || ascii::iequals(token, "close"); });
   }
   return close;
 }
@@ -112,8 +132,8 @@ void HttpServer::start() {
   int last_error = EADDRNOTAVAIL;
   UniqueFd listener;
   for (const addrinfo* ai = addresses.get(); ai != nullptr; ai = ai->ai_next) {
-    UniqueFd fd(::socket(ai->ai_family, ai->ai_socktype | SOCK_NONBLOCK | SOCK_CLOEXEC,
-                         ai->ai_protocol));
+    UniqueFd fd(
+        ::socket(ai->ai_family, ai->ai_socktype | SOCK_NONBLOCK | SOCK_CLOEXEC, ai->ai_protocol));
     if (!fd) {
       last_error = errno;
       continue;
@@ -135,10 +155,9 @@ void HttpServer::start() {
   if (::getsockname(listener.get(), reinterpret_cast<sockaddr*>(&bound), &bound_len) != 0) {
     throw std::runtime_error(where + ": getsockname failed: " + errno_text(errno));
   }
-  const std::uint16_t port =
-      bound.ss_family == AF_INET6
-          ? ntohs(reinterpret_cast<const sockaddr_in6&>(bound).sin6_port)
-          : ntohs(reinterpret_cast<const sockaddr_in&>(bound).sin_port);
+  const std::uint16_t port = bound.ss_family == AF_INET6
+                                 ? ntohs(reinterpret_cast<const sockaddr_in6&>(bound).sin6_port)
+                                 : ntohs(reinterpret_cast<const sockaddr_in&>(bound).sin_port);
 
   UniqueFd epoll(::epoll_create1(EPOLL_CLOEXEC));
   if (!epoll) throw std::runtime_error(where + ": epoll_create1 failed: " + errno_text(errno));
@@ -184,11 +203,11 @@ void HttpServer::run() {
     Clock::time_point wake_at = next_sweep_;
     if (listener_paused_) wake_at = std::min(wake_at, listener_resume_);
     const auto wait = std::chrono::ceil<std::chrono::milliseconds>(wake_at - now);
-    const int timeout = static_cast<int>(std::clamp<std::chrono::milliseconds::rep>(
-        wait.count(), 0, kMaxSweepInterval.count()));
+    const int timeout = static_cast<int>(
+        std::clamp<std::chrono::milliseconds::rep>(wait.count(), 0, kMaxSweepInterval.count()));
 
-    const int n = ::epoll_wait(epoll_.get(), events.data(), static_cast<int>(events.size()),
-                               timeout);
+    const int n =
+        ::epoll_wait(epoll_.get(), events.data(), static_cast<int>(events.size()), timeout);
     if (n < 0) {
       if (errno == EINTR) continue;
       throw std::runtime_error("HTTP server event loop failed: epoll_wait: " + errno_text(errno));
@@ -251,28 +270,12 @@ void HttpServer::accept_all(Clock::time_point now) {
                              SOCK_NONBLOCK | SOCK_CLOEXEC);
     if (fd < 0) {
       const int err = errno;
-      switch (err) {
-        case EAGAIN:
-        case EINTR:
-        // Linux reports errors already pending on the new connection through accept; they
-        // concern that one client only (accept(2), "Error handling").
-        case ECONNABORTED:
-        case EPROTO:
-        case ENETDOWN:
-        case ENOPROTOOPT:
-        case EHOSTDOWN:
-        case ENONET:
-        case EHOSTUNREACH:
-        case EOPNOTSUPP:
-        case ENETUNREACH:
-          if (err == EAGAIN) return;
-          continue;
-        default:
-          log("http: accept failed: " + errno_text(err) + "; pausing new connections for " +
-              std::to_string(kAcceptPause.count()) + " ms");
-          pause_listener(now);
-          return;
-      }
+      if (err == EAGAIN || err == EWOULDBLOCK) return;
+      if (err == EINTR || concerns_one_client(err)) continue;
+      log("http: accept failed: " + errno_text(err) + "; pausing new connections for " +
+          std::to_string(kAcceptPause.count()) + " ms");
+      pause_listener(now);
+      return;
     }
     UniqueFd client(fd);
     const std::size_t limit = config_.limits.max_connections;
@@ -285,8 +288,8 @@ void HttpServer::accept_all(Clock::time_point now) {
     ::setsockopt(client.get(), IPPROTO_TCP, TCP_NODELAY, &one, sizeof(one));
 
     const std::uint64_t id = next_id_++;
-    auto conn = std::make_unique<Connection>(id, std::move(client), peer_text(addr),
-                                             config_.limits, now);
+    auto conn =
+        std::make_unique<Connection>(id, std::move(client), peer_text(addr), config_.limits, now);
     epoll_event ev{};
     ev.events = EPOLLIN | EPOLLRDHUP;
     ev.data.u64 = id;
@@ -297,9 +300,9 @@ void HttpServer::accept_all(Clock::time_point now) {
     conn->events = ev.events;
     Connection& c = *connections_.emplace(id, std::move(conn)).first->second;
     if (over_limit) {
-      queue_error(c, 503,
-                  "the server already has " + std::to_string(limit) +
-                      " connections open; retry later");
+      queue_error(
+          c, 503,
+          "the server already has " + std::to_string(limit) + " connections open; retry later");
     }
     settle(c, now);
   }
@@ -377,8 +380,8 @@ void HttpServer::discard_input(Connection& conn) {
 }
 
 void HttpServer::process(Connection& conn, Clock::time_point now) {
-  while (!conn.closing && !conn.upgrade &&
-         conn.queued_responses < config_.limits.max_pipelined && !conn.unparsed().empty()) {
+  while (!conn.closing && !conn.upgrade && conn.queued_responses < config_.limits.max_pipelined &&
+         !conn.unparsed().empty()) {
     conn.in_parsed += conn.parser.feed(conn.unparsed());
     switch (conn.parser.state()) {
       case RequestParser::State::kError:
@@ -551,12 +554,12 @@ void HttpServer::on_timeout(Connection& conn, Clock::time_point now) {
     close(conn);  // idle keep-alive connection: closing silently is the convention
     return;
   }
-  const std::string message =
-      conn.parser.headers_complete()
-          ? "request body stalled for more than " +
-                std::to_string(config_.limits.body_timeout.count()) + " ms"
-          : "request header not received within " +
-                std::to_string(config_.limits.header_timeout.count()) + " ms";
+  const std::string message = conn.parser.headers_complete()
+                                  ? "request body stalled for more than " +
+                                        std::to_string(config_.limits.body_timeout.count()) + " ms"
+                                  : "request header not received within " +
+                                        std::to_string(config_.limits.header_timeout.count()) +
+                                        " ms";
   queue_error(conn, 408, message);
   conn.last_activity = now;
   settle(conn, now);

@@ -40,7 +40,9 @@ int hex_value(char c) {
   return -1;
 }
 
-std::string limit_text(std::size_t bytes) { return std::to_string(bytes) + " bytes"; }
+std::string limit_text(std::size_t bytes) {
+  return std::to_string(bytes) + " bytes";
+}
 
 }  // namespace
 
@@ -102,8 +104,7 @@ std::size_t RequestParser::feed(std::string_view data) {
       fail(400, "line ends in a bare LF; HTTP requires CRLF line endings");
       break;
     }
-    if (phase_ == Phase::kRequestLine || phase_ == Phase::kHeaders ||
-        phase_ == Phase::kTrailers) {
+    if (phase_ == Phase::kRequestLine || phase_ == Phase::kHeaders || phase_ == Phase::kTrailers) {
       head_bytes_ += line_.size();
     }
     on_line(std::string_view(line_.data(), line_.size() - 2));
@@ -128,8 +129,8 @@ bool RequestParser::check_line_limit() {
   switch (phase_) {
     case Phase::kRequestLine:
       if (line_.size() > limits_.max_target_bytes + kRequestLineSlack) {
-        return fail(414, "request target exceeds the limit of " +
-                             limit_text(limits_.max_target_bytes));
+        return fail(414,
+                    "request target exceeds the limit of " + limit_text(limits_.max_target_bytes));
       }
       [[fallthrough]];
     case Phase::kHeaders:
@@ -201,13 +202,12 @@ bool RequestParser::on_request_line(std::string_view line) {
     return fail(400, "malformed request line: invalid HTTP version");
   }
   if (version[5] != '1' || (version[7] != '0' && version[7] != '1')) {
-    return fail(505, "HTTP version " + std::string(version.substr(5)) +
-                         " is not supported; use HTTP/1.1");
+    return fail(
+        505, "HTTP version " + std::string(version.substr(5)) + " is not supported; use HTTP/1.1");
   }
 
   if (target.size() > limits_.max_target_bytes) {
-    return fail(414,
-                "request target exceeds the limit of " + limit_text(limits_.max_target_bytes));
+    return fail(414, "request target exceeds the limit of " + limit_text(limits_.max_target_bytes));
   }
   if (!std::all_of(target.begin(), target.end(), is_target_char)) {
     return fail(400,
@@ -237,8 +237,9 @@ bool RequestParser::on_request_line(std::string_view line) {
 
 bool RequestParser::on_field_line(std::string_view line, bool trailer) {
   if (ascii::is_ows(line.front())) {
-    return fail(400, "obsolete line folding (a header line starting with whitespace) is not "
-                     "supported");
+    return fail(400,
+                "obsolete line folding (a header line starting with whitespace) is not "
+                "supported");
   }
   const std::size_t colon = line.find(':');
   if (colon == std::string_view::npos) return fail(400, "header line without ':'");
@@ -276,15 +277,16 @@ bool RequestParser::on_headers_done() {
       transfer_encoding += h.value;
     } else if (ascii::iequals(h.name, "content-length")) {
       const std::string& v = h.value;
-      if (v.empty() || !std::all_of(v.begin(), v.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+      if (v.empty() ||
+          !std::all_of(v.begin(), v.end(), [](char c) { return c >= '0' && c <= '9'; })) {
         return fail(400, "invalid Content-Length; it must be a non-negative decimal integer");
       }
       std::uint64_t n = 0;
       for (char c : v) {
         const auto digit = static_cast<std::uint64_t>(c - '0');
         if (n > (std::numeric_limits<std::uint64_t>::max() - digit) / 10) {
-          return fail(413, "Content-Length exceeds the limit of " +
-                               limit_text(limits_.max_body_bytes));
+          return fail(413,
+                      "Content-Length exceeds the limit of " + limit_text(limits_.max_body_bytes));
         }
         n = n * 10 + digit;
       }
@@ -335,8 +337,8 @@ bool RequestParser::on_headers_done() {
 
   const std::uint64_t length = content_length.value_or(0);
   if (length > limits_.max_body_bytes) {
-    return fail(413, "request body of " + std::to_string(length) +
-                         " bytes exceeds the limit of " + limit_text(limits_.max_body_bytes));
+    return fail(413, "request body of " + std::to_string(length) + " bytes exceeds the limit of " +
+                         limit_text(limits_.max_body_bytes));
   }
   if (length == 0) return complete();
   request_.body.reserve(std::min<std::size_t>(length, kMaxBodyReserve));
@@ -357,8 +359,8 @@ bool RequestParser::on_chunk_size_line(std::string_view line) {
     const int v = hex_value(c);
     if (v < 0) return fail(400, "malformed chunk size line: chunk size must be hexadecimal");
     if (size > (std::numeric_limits<std::uint64_t>::max() >> 4)) {
-      return fail(413, "chunked request body exceeds the limit of " +
-                           limit_text(limits_.max_body_bytes));
+      return fail(
+          413, "chunked request body exceeds the limit of " + limit_text(limits_.max_body_bytes));
     }
     size = size * 16 + static_cast<std::uint64_t>(v);
   }
@@ -374,8 +376,8 @@ bool RequestParser::on_chunk_size_line(std::string_view line) {
     return true;
   }
   if (size > limits_.max_body_bytes - request_.body.size()) {
-    return fail(413, "chunked request body exceeds the limit of " +
-                         limit_text(limits_.max_body_bytes));
+    return fail(413,
+                "chunked request body exceeds the limit of " + limit_text(limits_.max_body_bytes));
   }
   remaining_ = size;
   phase_ = Phase::kChunkData;

@@ -83,7 +83,9 @@ void Router::add(std::string method, std::string pattern, Handler handler) {
   routes_.push_back(std::move(route));
 }
 
-void Router::set_fallback(Handler handler) { fallback_ = std::move(handler); }
+void Router::set_fallback(Handler handler) {
+  fallback_ = std::move(handler);
+}
 
 bool Router::match(const Route& route, const std::vector<std::string>& segments, Params* params) {
   if (route.segments.size() != segments.size()) return false;
@@ -100,8 +102,7 @@ bool Router::match(const Route& route, const std::vector<std::string>& segments,
         !actual.ends_with(pattern.suffix)) {
       return false;
     }
-    captured[pattern.capture] =
-        actual.substr(pattern.prefix.size(), actual.size() - affixes);
+    captured[pattern.capture] = actual.substr(pattern.prefix.size(), actual.size() - affixes);
   }
   if (params) *params = std::move(captured);
   return true;

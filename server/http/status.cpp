@@ -1,51 +1,70 @@
 #include "http/status.hpp"
 
 namespace scanplan::http {
+namespace {
+
+struct StatusInfo {
+  int status;
+  std::string_view reason;
+  std::string_view code;  // empty: not an error status
+};
+
+constexpr StatusInfo kStatuses[] = {
+    {100, "Continue", ""},
+    {101, "Switching Protocols", ""},
+    {200, "OK", ""},
+    {201, "Created", ""},
+    {202, "Accepted", ""},
+    {204, "No Content", ""},
+    {206, "Partial Content", ""},
+    {301, "Moved Permanently", ""},
+    {302, "Found", ""},
+    {303, "See Other", ""},
+    {304, "Not Modified", ""},
+    {307, "Temporary Redirect", ""},
+    {308, "Permanent Redirect", ""},
+    {400, "Bad Request", "bad_request"},
+    {401, "Unauthorized", "unauthorized"},
+    {403, "Forbidden", "forbidden"},
+    {404, "Not Found", "not_found"},
+    {405, "Method Not Allowed", "method_not_allowed"},
+    {406, "Not Acceptable", "not_acceptable"},
+    {408, "Request Timeout", "request_timeout"},
+    {409, "Conflict", "conflict"},
+    {410, "Gone", "gone"},
+    {411, "Length Required", "length_required"},
+    {412, "Precondition Failed", "precondition_failed"},
+    {413, "Content Too Large", "payload_too_large"},
+    {414, "URI Too Long", "uri_too_long"},
+    {415, "Unsupported Media Type", "unsupported_media_type"},
+    {416, "Range Not Satisfiable", "range_not_satisfiable"},
+    {417, "Expectation Failed", "expectation_failed"},
+    {422, "Unprocessable Content", "unprocessable"},
+    {426, "Upgrade Required", "upgrade_required"},
+    {428, "Precondition Required", "precondition_required"},
+    {429, "Too Many Requests", "too_many_requests"},
+    {431, "Request Header Fields Too Large", "header_fields_too_large"},
+    {500, "Internal Server Error", "internal"},
+    {501, "Not Implemented", "not_implemented"},
+    {502, "Bad Gateway", "bad_gateway"},
+    {503, "Service Unavailable", "service_unavailable"},
+    {504, "Gateway Timeout", "gateway_timeout"},
+    {505, "HTTP Version Not Supported", "http_version_not_supported"},
+    {507, "Insufficient Storage", "insufficient_storage"},
+    {511, "Network Authentication Required", "unauthorized"},
+};
+
+const StatusInfo* find(int status) {
+  for (const StatusInfo& info : kStatuses) {
+    if (info.status == status) return &info;
+  }
+  return nullptr;
+}
+
+}  // namespace
 
 std::string_view reason_phrase(int status) {
-  switch (status) {
-    case 100: return "Continue";
-    case 101: return "Switching Protocols";
-    case 200: return "OK";
-    case 201: return "Created";
-    case 202: return "Accepted";
-    case 204: return "No Content";
-    case 206: return "Partial Content";
-    case 301: return "Moved Permanently";
-    case 302: return "Found";
-    case 303: return "See Other";
-    case 304: return "Not Modified";
-    case 307: return "Temporary Redirect";
-    case 308: return "Permanent Redirect";
-    case 400: return "Bad Request";
-    case 401: return "Unauthorized";
-    case 403: return "Forbidden";
-    case 404: return "Not Found";
-    case 405: return "Method Not Allowed";
-    case 406: return "Not Acceptable";
-    case 408: return "Request Timeout";
-    case 409: return "Conflict";
-    case 410: return "Gone";
-    case 411: return "Length Required";
-    case 412: return "Precondition Failed";
-    case 413: return "Content Too Large";
-    case 414: return "URI Too Long";
-    case 415: return "Unsupported Media Type";
-    case 416: return "Range Not Satisfiable";
-    case 417: return "Expectation Failed";
-    case 422: return "Unprocessable Content";
-    case 426: return "Upgrade Required";
-    case 428: return "Precondition Required";
-    case 429: return "Too Many Requests";
-    case 431: return "Request Header Fields Too Large";
-    case 500: return "Internal Server Error";
-    case 501: return "Not Implemented";
-    case 502: return "Bad Gateway";
-    case 503: return "Service Unavailable";
-    case 504: return "Gateway Timeout";
-    case 505: return "HTTP Version Not Supported";
-    default: break;
-  }
+  if (const StatusInfo* info = find(status)) return info->reason;
   if (status >= 100 && status < 200) return "Informational";
   if (status >= 200 && status < 300) return "Success";
   if (status >= 300 && status < 400) return "Redirection";
@@ -54,28 +73,7 @@ std::string_view reason_phrase(int status) {
 }
 
 std::string_view error_code(int status) {
-  switch (status) {
-    case 400: return "bad_request";
-    case 401: return "unauthorized";
-    case 403: return "forbidden";
-    case 404: return "not_found";
-    case 405: return "method_not_allowed";
-    case 408: return "request_timeout";
-    case 409: return "conflict";
-    case 411: return "length_required";
-    case 413: return "payload_too_large";
-    case 414: return "uri_too_long";
-    case 415: return "unsupported_media_type";
-    case 417: return "expectation_failed";
-    case 422: return "unprocessable";
-    case 429: return "too_many_requests";
-    case 431: return "header_fields_too_large";
-    case 500: return "internal";
-    case 501: return "not_implemented";
-    case 503: return "service_unavailable";
-    case 505: return "http_version_not_supported";
-    default: break;
-  }
+  if (const StatusInfo* info = find(status); info && !info->code.empty()) return info->code;
   return status >= 500 ? "internal" : "bad_request";
 }
 

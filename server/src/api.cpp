@@ -71,11 +71,16 @@ Response Api::health() const {
 Response Api::session() const {
   const auto scans = store_.scans();
   json robots = json::object();
-  for (const auto& [id, s] : store_.robot_states()) {
-    robots[id] = {{"command_id", s.command_id},
-                  {"state", s.state},
-                  {"fraction", s.fraction},
-                  {"message", s.message}};
+  for (const auto& [id, r] : store_.robot_states()) {
+    robots[id] = {{"state", r.status.state},
+                  {"command_id", r.status.command_id},
+                  {"message", r.status.message},
+                  {"pose", pose_json(r.status.reported)},
+                  {"scan",
+                   {{"command_id", r.scan.command_id},
+                    {"state", r.scan.state},
+                    {"fraction", r.scan.fraction},
+                    {"message", r.scan.message}}}};
   }
   json j = {{"session_dir", session_dir_},
             {"started", iso_time(started_)},

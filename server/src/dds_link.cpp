@@ -4,6 +4,9 @@
 
 #include "ros2_types.h"
 #include "scanplan.h"
+#include "scanplan/core/colorizer.hpp"
+#include "scanplan/core/image_codec.hpp"
+#include "scanplan/msgs/camera_info.hpp"
 #include "scanplan/msgs/pointcloud2.hpp"
 #include "scanplan/msgs/pose_stamped.hpp"
 #include "scanplan/msgs/topics.hpp"
@@ -11,27 +14,31 @@
 namespace scanplan::server {
 namespace {
 
-// A scan whose other half never comes (a bridge that died between the two writes) must not
-// pin memory for the rest of the session.
-constexpr std::size_t kMaxPending = 8;
+// A scan whose other parts never come (a bridge that died between writes) must not pin memory
+// for the rest of the session.
+constexpr std::size_t kMaxPartial = 8;
+constexpr auto kImageWait = std::chrono::seconds(2);
+constexpr auto kPartialExpiry = std::chrono::seconds(60);
 
-template <typename Map>
-void trim_oldest(Map& m) {
-  while (m.size() > kMaxPending) m.erase(m.begin());
-}
+std::string str(const char* s) { return s ? s : ""; }
 
 }  // namespace
 
 DdsLink::DdsLink(std::uint32_t domain_id, ScanStore& store)
     : store_(store), participant_(domain_id) {
-  points_reader_ = participant_.reader(sensor_msgs_msg_dds__PointCloud2__desc, topics::kPoints,
-                                       dds::QosKind::kScanData);
-  pose_reader_ = participant_.reader(geometry_msgs_msg_dds__PoseStamped__desc, topics::kPose,
-                                     dds::QosKind::kScanData);
-  progress_reader_ = participant_.reader(scanplan_ScanProgress_desc, topics::kScanProgress,
-                                         dds::QosKind::kStatus);
-  scan_cmd_writer_ = participant_.writer(scanplan_ScanCommand_desc, topics::kScanCommand,
-                                         dds::QosKind::kCommand);
+  using dds::QosKind;
+  auto& p = participant_;
+  points_reader_ =
+      p.reader(sensor_msgs_msg_dds__PointCloud2__desc, topics::kPoints, QosKind::kScanData);
+  pose_reader_ =
+      p.reader(geometry_msgs_msg_dds__PoseStamped__desc, topics::kPose, QosKind::kScanData);
+  image_reader_ =
+      p.reader(sensor_msgs_msg_dds__CompressedImage__desc, topics::kImage, QosKind::kScanData);
+  camera_info_reader_ =
+      p.reader(sensor_msgs_msg_dds__CameraInfo__desc, topics::kCameraInfo, QosKind::kScanData);
+  progress_reader_ = p.reader(scanplan_ScanProgress_desc, topics::kScanProgress, QosKind::kStatus);
+  status_reader_ = p.reader(scanplan_RobotStatus_desc, topics::kRobotStatus, QosKind::kStatus);
+  scan_cmd_writer_ = p.writer(scanplan_ScanCommand_desc, topics::kScanCommand, QosKind::kCommand);
 }
 
 DdsLink::~DdsLink() { stop(); }
@@ -66,28 +73,12 @@ int DdsLink::connected_bridges() const {
 
 void DdsLink::loop() {
   try {
-    dds::ReadWaiter waiter(participant_.handle(), {points_reader_, pose_reader_, progress_reader_});
+    dds::ReadWaiter waiter(participant_.handle(),
+                           {points_reader_, pose_reader_, image_reader_, camera_info_reader_,
+                            progress_reader_, status_reader_});
     while (!stop_) {
-      if (!waiter.wait(std::chrono::milliseconds(100))) continue;
-      dds::take_all<scanplan_ScanProgress>(progress_reader_, [&](const scanplan_ScanProgress& p) {
-        store_.set_robot_state(p.robot_id ? p.robot_id : "",
-                               {p.command_id, p.state ? p.state : "", p.fraction,
-                                p.message ? p.message : ""});
-      });
-      dds::take_all<geometry_msgs_msg_dds__PoseStamped_>(
-          pose_reader_, [&](const geometry_msgs_msg_dds__PoseStamped_& m) {
-            on_pose(dds::robot_id_of(m.header.frame_id), dds::stamp_ns(m.header.stamp),
-                    dds::from_pose_stamped(m));
-          });
-      dds::take_all<sensor_msgs_msg_dds__PointCloud2_>(
-          points_reader_, [&](const sensor_msgs_msg_dds__PointCloud2_& m) {
-            const std::string robot = dds::robot_id_of(m.header.frame_id);
-            try {
-              on_points(robot, dds::stamp_ns(m.header.stamp), dds::unpack_pointcloud2(m));
-            } catch (const dds::PointCloud2Error& e) {
-              spdlog::warn("discarding a scan from '{}': {}", robot, e.what());
-            }
-          });
+      if (waiter.wait(std::chrono::milliseconds(100))) take_samples();
+      complete_scans();
     }
   } catch (const std::exception& e) {
     // Without DDS the session cannot receive scans, but the operator can still see the map.
@@ -95,32 +86,89 @@ void DdsLink::loop() {
   }
 }
 
-void DdsLink::on_points(const std::string& robot, std::int64_t stamp, PointCloud cloud) {
-  pending_points_[{robot, stamp}] = std::move(cloud);
-  trim_oldest(pending_points_);
-  try_pair(robot, stamp);
+void DdsLink::take_samples() {
+  dds::take_all<scanplan_ScanProgress>(progress_reader_, [&](const scanplan_ScanProgress& p) {
+    store_.set_scan_state(str(p.robot_id),
+                          {p.command_id, str(p.state), p.fraction, str(p.message)});
+  });
+  dds::take_all<scanplan_RobotStatus>(status_reader_, [&](const scanplan_RobotStatus& s) {
+    Pose pose;
+    pose.x = s.x;
+    pose.y = s.y;
+    pose.z = s.z;
+    pose.yaw = deg2rad(s.yaw_deg);
+    store_.set_robot_status(str(s.robot_id), {s.command_id, str(s.state), str(s.message), pose});
+  });
+  const auto key_of = [](const std_msgs_msg_dds__Header_& h) {
+    return Key{dds::robot_id_of(h.frame_id), dds::stamp_ns(h.stamp)};
+  };
+  dds::take_all<sensor_msgs_msg_dds__CameraInfo_>(
+      camera_info_reader_, [&](const sensor_msgs_msg_dds__CameraInfo_& m) {
+        try {
+          partial_[key_of(m.header)].camera = dds::from_camera_info(m);
+        } catch (const dds::CameraInfoError& e) {
+          spdlog::warn("ignoring camera info from '{}': {}", key_of(m.header).first, e.what());
+        }
+      });
+  dds::take_all<sensor_msgs_msg_dds__CompressedImage_>(
+      image_reader_, [&](const sensor_msgs_msg_dds__CompressedImage_& m) {
+        partial_[key_of(m.header)].jpeg.emplace(m.data._buffer, m.data._buffer + m.data._length);
+      });
+  dds::take_all<geometry_msgs_msg_dds__PoseStamped_>(
+      pose_reader_, [&](const geometry_msgs_msg_dds__PoseStamped_& m) {
+        partial_[key_of(m.header)].pose = dds::from_pose_stamped(m);
+      });
+  dds::take_all<sensor_msgs_msg_dds__PointCloud2_>(
+      points_reader_, [&](const sensor_msgs_msg_dds__PointCloud2_& m) {
+        const Key key = key_of(m.header);
+        try {
+          partial_[key].points = dds::unpack_pointcloud2(m);
+        } catch (const dds::PointCloud2Error& e) {
+          spdlog::warn("discarding a scan from '{}': {}", key.first, e.what());
+        }
+      });
 }
 
-void DdsLink::on_pose(const std::string& robot, std::int64_t stamp, const Pose& pose) {
-  pending_poses_[{robot, stamp}] = pose;
-  trim_oldest(pending_poses_);
-  try_pair(robot, stamp);
+void DdsLink::complete_scans() {
+  const auto now = std::chrono::steady_clock::now();
+  for (auto it = partial_.begin(); it != partial_.end();) {
+    PartialScan& s = it->second;
+    const bool has_image = s.jpeg && s.camera;
+    if (s.points && s.pose && (has_image || now - s.first_seen > kImageWait)) {
+      store_scan(it->first, s);
+      it = partial_.erase(it);
+    } else if (now - s.first_seen > kPartialExpiry) {
+      spdlog::warn("dropping an incomplete scan from '{}' (points {}, pose {})", it->first.first,
+                   s.points ? "in" : "missing", s.pose ? "in" : "missing");
+      it = partial_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  while (partial_.size() > kMaxPartial) partial_.erase(partial_.begin());
 }
 
-void DdsLink::try_pair(const std::string& robot, std::int64_t stamp) {
-  const Key key{robot, stamp};
-  auto p = pending_points_.find(key);
-  auto q = pending_poses_.find(key);
-  if (p == pending_points_.end() || q == pending_poses_.end()) return;
+void DdsLink::store_scan(const Key& key, PartialScan& s) {
+  const std::string& robot = key.first;
+  PointCloud& cloud = *s.points;
+  if (s.jpeg && s.camera) {
+    try {
+      const ColorizeStats stats = colorize(cloud, decode_image(*s.jpeg), *s.camera);
+      spdlog::info("colourised {} of {} points ({} hidden from the camera)", stats.colored,
+                   cloud.size(), stats.occluded);
+    } catch (const std::exception& e) {
+      spdlog::warn("scan from '{}' stays uncoloured: {}", robot, e.what());
+    }
+  } else if (!cloud.has_colors()) {
+    spdlog::warn("scan from '{}' came without a panorama: stored uncoloured", robot);
+  }
   try {
-    const ScanRecord r = store_.add(robot, q->second, stamp, p->second);
+    const ScanRecord r = store_.add(robot, *s.pose, key.second, cloud);
     spdlog::info("scan {} from '{}': {} points at ({:.2f}, {:.2f}, {:.2f})", r.id, robot, r.points,
                  r.pose.x, r.pose.y, r.pose.z);
   } catch (const std::exception& e) {
     spdlog::error("could not store a scan from '{}': {}", robot, e.what());
   }
-  pending_points_.erase(p);
-  pending_poses_.erase(q);
 }
 
 }  // namespace scanplan::server

@@ -1,14 +1,18 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <utility>
+#include <vector>
 
 #include "scan_store.hpp"
+#include "scanplan/core/panorama_camera.hpp"
 #include "scanplan/core/point_cloud.hpp"
 #include "scanplan/msgs/dds_participant.hpp"
 
@@ -19,8 +23,9 @@ class NoScannerError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// The server's side of DDS: receives scans, poses and progress from bridges on its own thread
-// and hands complete scans to the store; sends commands on behalf of the API.
+// The server's side of DDS: receives scans, poses, panoramas, progress and status from bridges
+// on its own thread, colourises each scan from its panorama and hands it to the store; sends
+// commands on behalf of the API.
 class DdsLink {
  public:
   DdsLink(std::uint32_t domain_id, ScanStore& store);
@@ -38,24 +43,32 @@ class DdsLink {
   int connected_bridges() const;
 
  private:
+  // The parts of one scan, which travel on four topics and may arrive in any order.
+  struct PartialScan {
+    std::optional<PointCloud> points;
+    std::optional<Pose> pose;
+    std::optional<std::vector<std::uint8_t>> jpeg;
+    std::optional<PanoramaCamera> camera;
+    std::chrono::steady_clock::time_point first_seen = std::chrono::steady_clock::now();
+  };
+  using Key = std::pair<std::string, std::int64_t>;  // robot id, stamp
+
   void loop();
-  void on_points(const std::string& robot, std::int64_t stamp, PointCloud cloud);
-  void on_pose(const std::string& robot, std::int64_t stamp, const Pose& pose);
-  void try_pair(const std::string& robot, std::int64_t stamp);
+  void take_samples();
+  // Stores every scan whose points and pose are in, once its panorama is in too or it has
+  // waited long enough for one (a robot without a camera, or a lost image).
+  void complete_scans();
+  void store_scan(const Key& key, PartialScan& scan);
 
   ScanStore& store_;
   dds::Participant participant_;
-  dds_entity_t points_reader_, pose_reader_, progress_reader_, scan_cmd_writer_;
+  dds_entity_t points_reader_, pose_reader_, image_reader_, camera_info_reader_, progress_reader_,
+      status_reader_, scan_cmd_writer_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
   std::mutex command_mutex_;
   std::uint32_t next_command_id_ = 1;
-
-  // Points and pose of one scan travel on two topics and may arrive in either order; they are
-  // paired by robot and stamp. Only touched by the DDS thread.
-  using Key = std::pair<std::string, std::int64_t>;
-  std::map<Key, PointCloud> pending_points_;
-  std::map<Key, Pose> pending_poses_;
+  std::map<Key, PartialScan> partial_;  // only touched by the DDS thread
 };
 
 }  // namespace scanplan::server

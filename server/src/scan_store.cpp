@@ -11,7 +11,7 @@ ScanRecord ScanStore::add(const std::string& robot_id, const Pose& pose, std::in
   placed.reserve(cloud.size());
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     placed.push_back(map_from_robot * cloud.points[i],
-                     cloud.has_colors() ? cloud.colors[i] : Rgb{255, 255, 255});
+                     cloud.has_colors() ? cloud.colors[i] : Rgb{128, 128, 128});
   }
 
   // Writers take turns on encode_mutex_; readers only wait for the short commit below, and
@@ -63,12 +63,17 @@ std::shared_ptr<const std::string> ScanStore::encoded_map() const {
   return encoded_;
 }
 
-void ScanStore::set_robot_state(const std::string& robot_id, RobotScanState state) {
+void ScanStore::set_scan_state(const std::string& robot_id, RobotScanState state) {
   std::lock_guard lock(mutex_);
-  robots_[robot_id] = std::move(state);
+  robots_[robot_id].scan = std::move(state);
 }
 
-std::map<std::string, RobotScanState> ScanStore::robot_states() const {
+void ScanStore::set_robot_status(const std::string& robot_id, RobotStatus status) {
+  std::lock_guard lock(mutex_);
+  robots_[robot_id].status = std::move(status);
+}
+
+std::map<std::string, RobotState> ScanStore::robot_states() const {
   std::lock_guard lock(mutex_);
   return robots_;
 }

@@ -28,6 +28,19 @@ struct RobotScanState {
   std::string message;
 };
 
+// What the robot last said about itself (scanplan_RobotStatus).
+struct RobotStatus {
+  std::uint32_t command_id = 0;
+  std::string state = "unknown";  // idle, moving, arrived, refused, scanning
+  std::string message;
+  Pose reported;
+};
+
+struct RobotState {
+  RobotStatus status;
+  RobotScanState scan;
+};
+
 // The scans of this session, in the map frame, plus the map's Draco encoding, rebuilt off the
 // network thread each time a scan lands so that serving the map never waits on the encoder.
 class ScanStore {
@@ -43,15 +56,16 @@ class ScanStore {
   // Null while the map is empty.
   std::shared_ptr<const std::string> encoded_map() const;
 
-  void set_robot_state(const std::string& robot_id, RobotScanState state);
-  std::map<std::string, RobotScanState> robot_states() const;
+  void set_scan_state(const std::string& robot_id, RobotScanState state);
+  void set_robot_status(const std::string& robot_id, RobotStatus status);
+  std::map<std::string, RobotState> robot_states() const;
 
  private:
   mutable std::mutex mutex_;
   std::vector<ScanRecord> scans_;
   PointCloud map_;
   std::shared_ptr<const std::string> encoded_;
-  std::map<std::string, RobotScanState> robots_;
+  std::map<std::string, RobotState> robots_;
   std::mutex encode_mutex_;  // one encoder run at a time; readers keep the previous result
 };
 

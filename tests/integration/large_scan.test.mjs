@@ -37,5 +37,5 @@ test(`a ${expected}-point scan arrives whole`, async () => {
   const session = await scanAndWait(stack, 1);
   assert.ok(expected > 300000);
   assert.equal(session.points, expected);
-  assert.equal(session.robots.robot1.message, `${expected} points`);
+  assert.equal(session.robots.robot1.scan.message, `${expected} points`);
 });

@@ -72,8 +72,8 @@ test('API answers with JSON errors and enforces tokens', async () => {
 
 test('a scan command brings a whole scan into the Draco map', async () => {
   const session = await scanAndWait(stack, 1);
-  assert.equal(session.robots.robot1.state, 'done');
-  assert.equal(session.robots.robot1.fraction, 1);
+  assert.equal(session.robots.robot1.scan.state, 'done');
+  assert.equal(session.robots.robot1.scan.fraction, 1);
   // 720 stage angles × 361 beams; about half look at the sky of the open yard.
   assert.ok(session.points > 100000 && session.points < 259920, `points: ${session.points}`);
   assert.equal(session.last_scan.points, session.points);

@@ -108,8 +108,8 @@ TEST(HttpRequestParser, ParsesSimpleGet) {
 }
 
 TEST(HttpRequestParser, DecodesPathAndQuery) {
-  const auto result = parse(
-      "GET /a%20b/c%2Fd?x=1%2B1&name=a+b&flag&&empty=&x=second HTTP/1.1\r\nHost: h\r\n\r\n");
+  const auto result =
+      parse("GET /a%20b/c%2Fd?x=1%2B1&name=a+b&flag&&empty=&x=second HTTP/1.1\r\nHost: h\r\n\r\n");
   ASSERT_EQ(result.error, 0) << result.message;
   const Request& r = result.requests.at(0);
   EXPECT_EQ(r.path, "/a b/c/d");
@@ -127,8 +127,7 @@ TEST(HttpRequestParser, KeepsDecodedDotDotAndNulForStaticServingToReject) {
 }
 
 TEST(HttpRequestParser, ParsesContentLengthBody) {
-  const auto result =
-      parse("POST /upload HTTP/1.1\r\nHost: h\r\nContent-Length: 5\r\n\r\nabcde");
+  const auto result = parse("POST /upload HTTP/1.1\r\nHost: h\r\nContent-Length: 5\r\n\r\nabcde");
   ASSERT_EQ(result.error, 0) << result.message;
   EXPECT_EQ(result.requests.at(0).body, "abcde");
 }
@@ -184,8 +183,7 @@ TEST(HttpRequestParser, PipelinedRequestsSplitAtEveryPairOfBoundaries) {
   const std::string_view all(kPipelined);
   for (std::size_t i = 0; i <= all.size(); ++i) {
     for (std::size_t j = i; j <= all.size(); j += 3) {
-      const auto result =
-          parse_chunks({all.substr(0, i), all.substr(i, j - i), all.substr(j)});
+      const auto result = parse_chunks({all.substr(0, i), all.substr(i, j - i), all.substr(j)});
       ASSERT_EQ(result.error, 0) << "split at " << i << "," << j;
       ASSERT_EQ(result.requests.size(), 3u) << "split at " << i << "," << j;
       for (std::size_t k = 0; k < 3; ++k) expect_same(result.requests[k], reference.requests[k]);
@@ -297,7 +295,9 @@ struct ErrorCase {
   int status;
 };
 
-void PrintTo(const ErrorCase& c, std::ostream* os) { *os << c.name; }
+void PrintTo(const ErrorCase& c, std::ostream* os) {
+  *os << c.name;
+}
 
 class HttpRequestParserErrors : public ::testing::TestWithParam<ErrorCase> {};
 
@@ -354,25 +354,22 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"nul_in_value", bytes("GET / HTTP/1.1\r\nHost: h\0x\r\n\r\n"), 400},
         ErrorCase{"missing_host", "GET / HTTP/1.1\r\nAccept: */*\r\n\r\n", 400},
         ErrorCase{"two_hosts", "GET / HTTP/1.1\r\nHost: a\r\nHost: b\r\n\r\n", 400},
-        ErrorCase{"cl_letters", "POST / HTTP/1.1\r\n" + kHost + "Content-Length: abc\r\n\r\n",
-                  400},
-        ErrorCase{"cl_negative", "POST / HTTP/1.1\r\n" + kHost + "Content-Length: -1\r\n\r\n",
-                  400},
+        ErrorCase{"cl_letters", "POST / HTTP/1.1\r\n" + kHost + "Content-Length: abc\r\n\r\n", 400},
+        ErrorCase{"cl_negative", "POST / HTTP/1.1\r\n" + kHost + "Content-Length: -1\r\n\r\n", 400},
         ErrorCase{"cl_plus", "POST / HTTP/1.1\r\n" + kHost + "Content-Length: +1\r\n\r\n", 400},
         ErrorCase{"cl_empty", "POST / HTTP/1.1\r\n" + kHost + "Content-Length:\r\n\r\n", 400},
-        ErrorCase{"cl_list", "POST / HTTP/1.1\r\n" + kHost + "Content-Length: 1, 1\r\n\r\nx",
-                  400},
+        ErrorCase{"cl_list", "POST / HTTP/1.1\r\n" + kHost + "Content-Length: 1, 1\r\n\r\nx", 400},
         ErrorCase{"cl_hex", "POST / HTTP/1.1\r\n" + kHost + "Content-Length: 0x10\r\n\r\n", 400},
-        ErrorCase{"cl_space_inside",
-                  "POST / HTTP/1.1\r\n" + kHost + "Content-Length: 1 0\r\n\r\n", 400},
-        ErrorCase{"cl_conflict",
-                  "POST / HTTP/1.1\r\n" + kHost +
-                      "Content-Length: 1\r\nContent-Length: 2\r\n\r\nxx",
+        ErrorCase{"cl_space_inside", "POST / HTTP/1.1\r\n" + kHost + "Content-Length: 1 0\r\n\r\n",
                   400},
-        ErrorCase{"cl_overflow",
-                  "POST / HTTP/1.1\r\n" + kHost +
-                      "Content-Length: 99999999999999999999999999\r\n\r\n",
-                  413},
+        ErrorCase{
+            "cl_conflict",
+            "POST / HTTP/1.1\r\n" + kHost + "Content-Length: 1\r\nContent-Length: 2\r\n\r\nxx",
+            400},
+        ErrorCase{
+            "cl_overflow",
+            "POST / HTTP/1.1\r\n" + kHost + "Content-Length: 99999999999999999999999999\r\n\r\n",
+            413},
         ErrorCase{"cl_and_te",
                   "POST / HTTP/1.1\r\n" + kHost +
                       "Content-Length: 3\r\nTransfer-Encoding: chunked\r\n\r\n0\r\n\r\n",
@@ -381,39 +378,33 @@ INSTANTIATE_TEST_SUITE_P(
                   "POST / HTTP/1.1\r\n" + kHost +
                       "Transfer-Encoding: chunked\r\nContent-Length: 3\r\n\r\n0\r\n\r\n",
                   400},
-        ErrorCase{"te_gzip",
-                  "POST / HTTP/1.1\r\n" + kHost + "Transfer-Encoding: gzip\r\n\r\n", 501},
-        ErrorCase{"te_gzip_chunked",
-                  "POST / HTTP/1.1\r\n" + kHost + "Transfer-Encoding: gzip, chunked\r\n\r\n",
+        ErrorCase{"te_gzip", "POST / HTTP/1.1\r\n" + kHost + "Transfer-Encoding: gzip\r\n\r\n",
                   501},
+        ErrorCase{"te_gzip_chunked",
+                  "POST / HTTP/1.1\r\n" + kHost + "Transfer-Encoding: gzip, chunked\r\n\r\n", 501},
         ErrorCase{"te_chunked_twice",
                   "POST / HTTP/1.1\r\n" + kHost +
                       "Transfer-Encoding: chunked\r\nTransfer-Encoding: chunked\r\n\r\n",
                   400},
-        ErrorCase{"te_empty", "POST / HTTP/1.1\r\n" + kHost + "Transfer-Encoding: \r\n\r\n",
+        ErrorCase{"te_empty", "POST / HTTP/1.1\r\n" + kHost + "Transfer-Encoding: \r\n\r\n", 400},
+        ErrorCase{"te_in_http10", "POST / HTTP/1.0\r\nTransfer-Encoding: chunked\r\n\r\n0\r\n\r\n",
                   400},
-        ErrorCase{"te_in_http10",
-                  "POST / HTTP/1.0\r\nTransfer-Encoding: chunked\r\n\r\n0\r\n\r\n", 400},
         ErrorCase{"chunk_size_not_hex",
-                  "POST / HTTP/1.1\r\n" + kHost + "Transfer-Encoding: chunked\r\n\r\nzz\r\n",
-                  400},
+                  "POST / HTTP/1.1\r\n" + kHost + "Transfer-Encoding: chunked\r\n\r\nzz\r\n", 400},
         ErrorCase{"chunk_size_empty",
-                  "POST / HTTP/1.1\r\n" + kHost + "Transfer-Encoding: chunked\r\n\r\n;x\r\n",
-                  400},
+                  "POST / HTTP/1.1\r\n" + kHost + "Transfer-Encoding: chunked\r\n\r\n;x\r\n", 400},
         ErrorCase{"chunk_size_negative",
-                  "POST / HTTP/1.1\r\n" + kHost + "Transfer-Encoding: chunked\r\n\r\n-1\r\n",
-                  400},
+                  "POST / HTTP/1.1\r\n" + kHost + "Transfer-Encoding: chunked\r\n\r\n-1\r\n", 400},
         ErrorCase{"chunk_size_leading_space",
-                  "POST / HTTP/1.1\r\n" + kHost + "Transfer-Encoding: chunked\r\n\r\n 1\r\n",
-                  400},
+                  "POST / HTTP/1.1\r\n" + kHost + "Transfer-Encoding: chunked\r\n\r\n 1\r\n", 400},
         ErrorCase{"chunk_data_too_long",
                   "POST / HTTP/1.1\r\n" + kHost +
                       "Transfer-Encoding: chunked\r\n\r\n2\r\nabc\r\n0\r\n\r\n",
                   400},
-        ErrorCase{"chunk_bare_lf",
-                  "POST / HTTP/1.1\r\n" + kHost +
-                      "Transfer-Encoding: chunked\r\n\r\n2\nab\r\n0\r\n\r\n",
-                  400},
+        ErrorCase{
+            "chunk_bare_lf",
+            "POST / HTTP/1.1\r\n" + kHost + "Transfer-Encoding: chunked\r\n\r\n2\nab\r\n0\r\n\r\n",
+            400},
         ErrorCase{"chunk_size_overflow",
                   "POST / HTTP/1.1\r\n" + kHost +
                       "Transfer-Encoding: chunked\r\n\r\nFFFFFFFFFFFFFFFFFF\r\n",
@@ -429,8 +420,9 @@ INSTANTIATE_TEST_SUITE_P(
     [](const ::testing::TestParamInfo<ErrorCase>& info) { return std::string(info.param.name); });
 
 TEST(HttpRequestParser, AcceptsIdenticalDuplicateContentLength) {
-  const auto result = parse("POST / HTTP/1.1\r\nHost: h\r\nContent-Length: 2\r\n"
-                            "Content-Length: 02\r\n\r\nok");
+  const auto result = parse(
+      "POST / HTTP/1.1\r\nHost: h\r\nContent-Length: 2\r\n"
+      "Content-Length: 02\r\n\r\nok");
   ASSERT_EQ(result.error, 0) << result.message;
   EXPECT_EQ(result.requests.at(0).body, "ok");
 }
@@ -512,9 +504,15 @@ TEST(HttpRequestParser, SurvivesRandomMutations) {
     for (int m = 0; m < mutations; ++m) {
       const std::size_t at = rng() % text.size();
       switch (rng() % 3) {
-        case 0: text[at] = alphabet[rng() % alphabet.size()]; break;
-        case 1: text.insert(at, 1, alphabet[rng() % alphabet.size()]); break;
-        default: text.erase(at, 1 + rng() % 8); break;
+        case 0:
+          text[at] = alphabet[rng() % alphabet.size()];
+          break;
+        case 1:
+          text.insert(at, 1, alphabet[rng() % alphabet.size()]);
+          break;
+        default:
+          text.erase(at, 1 + rng() % 8);
+          break;
       }
       if (text.empty()) text = "x";
     }
@@ -532,7 +530,9 @@ TEST(HttpRequestParser, SurvivesRandomMutations) {
           parser.take();
           continue;
         }
-        if (parser.state() == State::kIncomplete) ASSERT_TRUE(chunk.empty());
+        if (parser.state() == State::kIncomplete) {
+          ASSERT_TRUE(chunk.empty());
+        }
         break;
       }
     }

@@ -9,7 +9,9 @@
 namespace scanplan::http {
 namespace {
 
-std::string head_of(const std::string& wire) { return wire.substr(0, wire.find("\r\n\r\n") + 4); }
+std::string head_of(const std::string& wire) {
+  return wire.substr(0, wire.find("\r\n\r\n") + 4);
+}
 
 TEST(HttpResponse, SerializesStatusHeadersAndBody) {
   Response r = Response::bytes("hello", "text/plain");
@@ -74,13 +76,14 @@ TEST(HttpResponse, ErrorHasTheRestShape) {
   EXPECT_EQ(r.status, 404);
   EXPECT_EQ(r.header("content-type"), "application/json");
   const auto j = nlohmann::json::parse(r.body);
-  EXPECT_EQ(j, (nlohmann::json{{"error", {{"code", "not_found"}, {"message", "no scan with id 7"}}}}));
+  EXPECT_EQ(j,
+            (nlohmann::json{{"error", {{"code", "not_found"}, {"message", "no scan with id 7"}}}}));
 }
 
 TEST(HttpResponse, JsonToleratesInvalidUtf8) {
   Response r;
   EXPECT_NO_THROW(r = Response::error(400, "bad_request", "bad path /\xff\xfe"));
-  EXPECT_NO_THROW(static_cast<void>(nlohmann::json::parse(r.body)));
+  EXPECT_TRUE(nlohmann::json::accept(r.body));
 }
 
 TEST(HttpResponse, SetHeaderReplacesCaseInsensitively) {

@@ -26,7 +26,9 @@ Router::Handler echo(std::string name) {
   };
 }
 
-nlohmann::json body_of(const Response& r) { return nlohmann::json::parse(r.body); }
+nlohmann::json body_of(const Response& r) {
+  return nlohmann::json::parse(r.body);
+}
 
 class HttpRouterTest : public ::testing::Test {
  protected:
@@ -65,8 +67,7 @@ TEST_F(HttpRouterTest, CapturesParametersPerSegment) {
 }
 
 TEST_F(HttpRouterTest, LiteralBeatsCaptureRegardlessOfOrder) {
-  EXPECT_EQ(body_of(router_.route(make_request("GET", "/api/v1/scans/latest")))["route"],
-            "latest");
+  EXPECT_EQ(body_of(router_.route(make_request("GET", "/api/v1/scans/latest")))["route"], "latest");
   EXPECT_EQ(body_of(router_.route(make_request("GET", "/api/v1/scans/7")))["route"], "scan");
 }
 

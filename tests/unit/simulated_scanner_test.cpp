@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "scanplan/core/simulated_scanner.hpp"
 
 namespace scanplan {
@@ -69,6 +71,53 @@ TEST(SimulatedScanner, SameSeedSameScanAndNoiseHasItsSpread) {
   ASSERT_GT(n, 50);
   const double sd = std::sqrt(sum2 / n - (sum / n) * (sum / n));
   EXPECT_NEAR(sd, w.scanner.range_noise_m, 0.004);
+}
+
+TEST(SimulatedScanner, ThreadCountDoesNotChangeTheScan) {
+  World w = load_world(SCANPLAN_SOURCE_DIR "/samples/worlds/campus.json");
+  w.scanner.rotation_step_deg = 2.0;
+  w.scanner.vertical_step_deg = 1.0;
+  const RayCaster rc(w);
+  const PointCloud serial = simulate_scan(rc, w.scanner, w.start, 42, {}, 1);
+  const PointCloud a = simulate_scan(rc, w.scanner, w.start, 42, {}, 2);
+  const PointCloud b = simulate_scan(rc, w.scanner, w.start, 42, {}, 2);
+  ASSERT_GT(serial.size(), 10000u);
+  ASSERT_TRUE(serial.has_colors());
+  for (const PointCloud* c : {&a, &b}) {
+    ASSERT_EQ(c->size(), serial.size());
+    EXPECT_TRUE(std::equal(c->points.begin(), c->points.end(), serial.points.begin()));
+    EXPECT_TRUE(std::equal(c->colors.begin(), c->colors.end(), serial.colors.begin()));
+  }
+  const PointCloud other_seed = simulate_scan(rc, w.scanner, w.start, 43, {}, 2);
+  EXPECT_FALSE(
+      other_seed.size() == serial.size() &&
+      std::equal(other_seed.points.begin(), other_seed.points.end(), serial.points.begin()))
+      << "another seed must give other noise";
+}
+
+TEST(SimulatedScanner, ProgressIsReportedInOrderAndCanAbort) {
+  World w = flat_world();
+  w.scanner.rotation_step_deg = 1.0;
+  w.scanner.vertical_step_deg = 2.0;
+  const RayCaster rc(w);
+  std::vector<double> seen;
+  const PointCloud full = simulate_scan(
+      rc, w.scanner, w.start, 5,
+      [&](double f) {
+        seen.push_back(f);
+        return true;
+      },
+      2);
+  ASSERT_EQ(seen.size(), 120u);  // 360 stage angles, reported every 360 / 100 → 3
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_DOUBLE_EQ(seen.back(), 1.0);
+  EXPECT_EQ(full.size(), simulate_scan(rc, w.scanner, w.start, 5, {}, 2).size());
+  // Stopping after a quarter keeps exactly the stage angles scanned so far.
+  const PointCloud part = simulate_scan(
+      rc, w.scanner, w.start, 5, [](double f) { return f < 0.25; }, 2);
+  EXPECT_GT(part.size(), full.size() / 5);
+  EXPECT_LT(part.size(), full.size() / 3);
+  EXPECT_TRUE(std::equal(part.points.begin(), part.points.end(), full.points.begin()));
 }
 
 TEST(SimulatedScanner, ReportedPoseNoiseHasConfiguredSpread) {

@@ -14,6 +14,11 @@ struct ScannerConfig {
   double range_noise_m = 0.01;  // 1σ
   double mount_height_m = 1.0;  // scanner centre above the ground under the robot
   double scan_duration_s = 60.0;
+  // The colour camera: one equirectangular panorama per scan (height = width / 2), its optical
+  // centre this far above the laser's.
+  int camera_width_px = 1024;
+  double camera_above_laser_m = 0.15;
+  int camera_jpeg_quality = 90;
 
   int vertical_samples() const;
   int rotation_samples() const;

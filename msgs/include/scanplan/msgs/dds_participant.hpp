@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <type_traits>
 
 namespace scanplan::dds {
 
@@ -50,8 +51,8 @@ class Participant {
   std::map<std::string, dds_entity_t> topics_;
 };
 
-// Takes every available sample from `reader` (loaned, no copy) and calls fn(const T&) for each
-// valid one. Returns how many valid samples were seen.
+// Takes every available sample from `reader` (loaned, no copy) and calls fn(const T&) or
+// fn(const T&, const dds_sample_info_t&) for each valid one. Returns how many were seen.
 template <typename T, typename Fn>
 int take_all(dds_entity_t reader, Fn&& fn) {
   constexpr int kBatch = 16;
@@ -63,7 +64,11 @@ int take_all(dds_entity_t reader, Fn&& fn) {
     check(n, "dds_take");
     for (int i = 0; i < n; ++i) {
       if (infos[i].valid_data) {
-        fn(*static_cast<const T*>(samples[i]));
+        if constexpr (std::is_invocable_v<Fn, const T&, const dds_sample_info_t&>) {
+          fn(*static_cast<const T*>(samples[i]), infos[i]);
+        } else {
+          fn(*static_cast<const T*>(samples[i]));
+        }
         ++seen;
       }
     }

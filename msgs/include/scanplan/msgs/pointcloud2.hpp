@@ -33,7 +33,8 @@ class PointCloud2Error : public std::runtime_error {
 };
 
 // Reads x, y, z (float32) and, when present, ROS's packed `rgb`/`rgba` field from any
-// PointCloud2 layout; non-finite points are dropped. Throws PointCloud2Error for a message
+// PointCloud2 layout; non-finite points are dropped. A cloud whose colours are all 0 (not
+// colourised) comes back without colours. Throws PointCloud2Error for a message
 // whose sizes or fields do not add up.
 PointCloud unpack_pointcloud2(const sensor_msgs_msg_dds__PointCloud2_& msg);
 

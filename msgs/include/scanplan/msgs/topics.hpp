@@ -6,6 +6,10 @@ namespace scanplan::topics {
 
 inline constexpr const char* kPoints = "rt/scanner/points";
 inline constexpr const char* kPose = "rt/scanner/pose";
+inline constexpr const char* kImage = "rt/scanner/image/compressed";
+inline constexpr const char* kCameraInfo = "rt/scanner/camera_info";
+inline constexpr const char* kRobotStatus = "scanplan_RobotStatus";
+inline constexpr const char* kMoveCommand = "scanplan_MoveCommand";
 inline constexpr const char* kScanProgress = "scanplan_ScanProgress";
 inline constexpr const char* kScanCommand = "scanplan_ScanCommand";
 
