@@ -7,8 +7,7 @@
 #include <thread>
 
 #include "scanplan/core/image_codec.hpp"
-#include "scanplan/core/panorama_renderer.hpp"
-#include "scanplan/core/simulated_scanner.hpp"
+#include "scanplan/core/simulated_shot.hpp"
 
 namespace scanplan::bridge {
 
@@ -77,15 +76,13 @@ void SimulatedRobot::scan(std::uint32_t command_id, const std::atomic<bool>& sto
     return !stop.load();
   };
   const std::uint64_t seed = options_.seed * 1000003u + scans_taken_++;
-  PointCloud cloud = simulate_scan(caster_, cfg, true_pose_, seed, progress);
-  if (stop) {
+  auto simulated = simulate_shot(caster_, cfg, true_pose_, seed, progress);
+  if (!simulated) {
     publisher_.progress(command_id, "failed", last_reported, "the scanner was shut down mid-scan");
     return;
   }
-  // The laser sees no colour: the server colourises from the panorama.
-  cloud.colors.clear();
-  CameraShot shot{{}, PanoramaCamera::for_scanner(cfg)};
-  shot.jpeg = encode_jpeg(render_panorama(caster_, shot.camera, true_pose_), cfg.camera_jpeg_quality);
+  const PointCloud& cloud = simulated->cloud;
+  CameraShot shot{encode_jpeg(simulated->panorama, cfg.camera_jpeg_quality), simulated->camera};
   publisher_.scan(cloud, reported_, shot);
   publisher_.progress(command_id, "done", 1.0f, std::to_string(cloud.size()) + " points");
   publisher_.status(command_id, "idle", reported_);

@@ -90,8 +90,10 @@ PointCloud parse_threedtk_scan(std::string_view text, const std::string& source_
                                ThreedtkScanInfo* info, const ThreedtkScanOptions& options) {
   ThreedtkScanInfo stats;
   PointCloud cloud;
-  // One point per line at most, so this reservation is bounded by the file's size.
-  cloud.points.reserve(static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1);
+  // One point per line at most, and a point line takes at least 6 bytes ("1 2 3\n"), so this
+  // reservation stays in proportion to the file however many empty lines it has.
+  const auto lines = static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
+  cloud.points.reserve(std::min(lines, text.size() / 6 + 1));
   const double min_range_cm = options.min_range_m * 100.0;
   const double max_range_cm = options.max_range_m * 100.0;
 

@@ -60,7 +60,7 @@ async function waitFor(what, fn, timeoutMs, procs = []) {
   }
 }
 
-export async function startStack({ world, timeScale = 600, seed = 1 } = {}) {
+export async function startStack({ world, replay, timeScale = 600, seed = 1 } = {}) {
   const dir = mkdtempSync(join(tmpdir(), 'scanplan-test-'));
   const domain = requireEnv('SCANPLAN_TEST_DOMAIN');
   const token = randomBytes(16).toString('hex');
@@ -74,7 +74,8 @@ export async function startStack({ world, timeScale = 600, seed = 1 } = {}) {
     { SCANPLAN_OPERATOR_TOKEN: token, SCANPLAN_VIEWER_TOKEN: viewerToken }, 'scanplan-server');
   const bridge = startProcess(
     requireEnv('SCANPLAN_BRIDGE'),
-    ['--world', worldFile, '--domain', domain, '--time-scale', String(timeScale), '--seed', String(seed)],
+    [...(replay ? ['--replay', replay] : ['--world', worldFile]),
+     '--domain', domain, '--time-scale', String(timeScale), '--seed', String(seed)],
     {}, 'scanplan-bridge');
   const procs = [server, bridge];
 
@@ -103,10 +104,16 @@ export async function startStack({ world, timeScale = 600, seed = 1 } = {}) {
   return stack;
 }
 
-// Asks for one scan and waits until the session holds `count` scans.
-export async function scanAndWait(stack, count) {
+// Asks for one scan; returns the command id.
+export async function requestScan(stack) {
   const r = await stack.api('POST', '/api/v1/scan');
   if (r.status !== 202) throw new Error(`POST /api/v1/scan answered ${r.status}: ${await r.text()}`);
+  return (await r.json()).command_id;
+}
+
+// Asks for one scan and waits until the session holds `count` scans.
+export async function scanAndWait(stack, count) {
+  await requestScan(stack);
   return stack.waitFor(`scan ${count} in the session`, async () => {
     const s = await (await stack.api('GET', '/api/v1/session')).json();
     return s.scans >= count ? s : undefined;

@@ -1,0 +1,22 @@
+// scanplan: the command-line tool (DESIGN.md "CLI"). JSON results on stdout; human text and
+// progress on stderr.
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+
+#include "scan_command.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"scanplan: offline tools and terminal operator for the scanplan workstation"};
+  app.require_subcommand(1);
+  scanplan::cli::add_scan_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::cerr << "scanplan: " << e.what() << std::endl;
+    return 1;
+  }
+  return 0;
+}
