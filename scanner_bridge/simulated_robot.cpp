@@ -18,7 +18,8 @@ SimulatedRobot::SimulatedRobot(World world, dds::Participant& participant, Bridg
       options_(std::move(options)),
       publisher_(participant, options_.robot_id),
       commands_(participant, options_.robot_id),
-      true_pose_(world_.start),
+      true_pose_(traversability_.standing_pose(world_.start.x, world_.start.y, world_.start.z,
+                                               world_.start.yaw)),
       pose_rng_(options_.seed) {
   reported_ = reported_pose(true_pose_, world_.pose_noise, pose_rng_);
 }
@@ -111,10 +112,8 @@ void SimulatedRobot::move(const MoveRequest& goal, const std::atomic<bool>& stop
                goal.x, goal.y);
   publisher_.status(goal.command_id, "moving", reported_);
   if (!pass_time(distance / options_.speed_mps, stop)) return;
-  true_pose_.x = goal.x;
-  true_pose_.y = goal.y;
-  true_pose_.z = reach.z[*goal_cell];
-  true_pose_.yaw = deg2rad(goal.yaw_deg);
+  true_pose_ =
+      traversability_.standing_pose(goal.x, goal.y, reach.z[*goal_cell], deg2rad(goal.yaw_deg));
   reported_ = reported_pose(true_pose_, world_.pose_noise, pose_rng_);
   publisher_.status(goal.command_id, "arrived", reported_,
                     "drove " + std::to_string(static_cast<int>(std::lround(distance))) + " m");

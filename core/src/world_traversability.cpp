@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+
+#include <Eigen/Geometry>
 #include <queue>
 #include <stdexcept>
 
@@ -15,7 +17,7 @@ constexpr int kMaxLayers = 16;  // surfaces probed per cell; far more than any w
 
 WorldTraversability::WorldTraversability(const World& world, const RayCaster& caster,
                                          const TraversabilityOptions& options)
-    : world_(world), options_(options) {
+    : world_(world), caster_(caster), options_(options) {
   const Eigen::Vector2d extent = world.bounds_max - world.bounds_min;
   cols_ = std::max(1, static_cast<int>(std::ceil(extent.x() / options.cell_m)));
   rows_ = std::max(1, static_cast<int>(std::ceil(extent.y() / options.cell_m)));
@@ -126,6 +128,28 @@ WorldTraversability::Reach WorldTraversability::reach_from(double x, double y, d
     }
   }
   return r;
+}
+
+Pose WorldTraversability::standing_pose(double x, double y, double z, double yaw) const {
+  // The robot's wheels span about this much: the slope over that base tilts it.
+  constexpr double kHalfBaseM = 0.4;
+  const auto height_at = [&](double px, double py) {
+    const auto hit = caster_.cast({px, py, z + 1.0}, {0, 0, -1}, 0.0, 2.0);
+    return hit && !hit->exiting ? z + 1.0 - hit->range : z;
+  };
+  const double gx = (height_at(x + kHalfBaseM, y) - height_at(x - kHalfBaseM, y)) / (2 * kHalfBaseM);
+  const double gy = (height_at(x, y + kHalfBaseM) - height_at(x, y - kHalfBaseM)) / (2 * kHalfBaseM);
+  // The ground normal in the robot's yaw frame; Ry(pitch)·Rx(roll) must turn z onto it.
+  const Eigen::Vector3d n =
+      Eigen::AngleAxisd(-yaw, Eigen::Vector3d::UnitZ()) * Eigen::Vector3d(-gx, -gy, 1).normalized();
+  Pose p;
+  p.x = x;
+  p.y = y;
+  p.z = z;
+  p.yaw = yaw;
+  p.roll = -std::asin(std::clamp(n.y(), -1.0, 1.0));
+  p.pitch = std::atan2(n.x(), n.z());
+  return p;
 }
 
 std::vector<std::size_t> WorldTraversability::Reach::path_to(std::size_t cell) const {

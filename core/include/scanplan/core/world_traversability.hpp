@@ -45,8 +45,13 @@ class WorldTraversability {
   // Throws std::invalid_argument when (x, y, z) is not on a surface of the region.
   Reach reach_from(double x, double y, double z) const;
 
+  // The pose of a robot standing at (x, y) on the surface near height z, facing `yaw`: roll
+  // and pitch follow the ground under it (what the inclination sensor measures, paper §4.3).
+  Pose standing_pose(double x, double y, double z, double yaw) const;
+
  private:
-  const World& world_;
+  const World& world_;  // must outlive this object
+  RayCaster caster_;    // a cheap copy sharing the built structure
   TraversabilityOptions options_;
   int cols_ = 0, rows_ = 0;
   std::vector<std::vector<float>> surfaces_;
