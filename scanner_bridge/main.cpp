@@ -1,8 +1,8 @@
 // scanplan-bridge: the scanner robot on DDS (DESIGN.md "Processes"): a simulated robot in a
 // world file, or a recording played back.
-#include <CLI/CLI.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
 
 #include <atomic>
 #include <csignal>
@@ -13,7 +13,9 @@
 
 namespace {
 std::atomic<bool> g_stop{false};
-void on_signal(int) { g_stop = true; }
+void on_signal(int) {
+  g_stop = true;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -44,7 +46,8 @@ int main(int argc, char** argv) {
   try {
     scanplan::dds::Participant participant(domain);
     if (!world_file.empty()) {
-      scanplan::bridge::SimulatedRobot robot(scanplan::load_world(world_file), participant, options);
+      scanplan::bridge::SimulatedRobot robot(scanplan::load_world(world_file), participant,
+                                             options);
       robot.run(g_stop);
     } else {
       scanplan::bridge::ReplayOptions replay{options.robot_id, options.time_scale};

@@ -53,9 +53,9 @@ void ReplayRobot::run(const std::atomic<bool>& stop) {
 
 void ReplayRobot::scan(std::uint32_t command_id, const std::atomic<bool>& stop) {
   if (next_ >= folder_.size()) {
-    publisher_.progress(command_id, "failed", 0.0f,
-                        "the recording has no more scans (" + std::to_string(folder_.size()) +
-                            " played)");
+    publisher_.progress(
+        command_id, "failed", 0.0f,
+        "the recording has no more scans (" + std::to_string(folder_.size()) + " played)");
     return;
   }
   const std::size_t index = next_++;
@@ -82,9 +82,10 @@ void ReplayRobot::scan(std::uint32_t command_id, const std::atomic<bool>& stop) 
   }
   // A recorded scan still takes its minute, so the operator sees the session as it happened.
   if (options_.time_scale > 0) {
-    const auto until = started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                     std::chrono::duration<double>(options_.scan_duration_s /
-                                                                   options_.time_scale));
+    const auto until =
+        started +
+        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+            std::chrono::duration<double>(options_.scan_duration_s / options_.time_scale));
     while (!stop && std::chrono::steady_clock::now() < until) {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
@@ -99,8 +100,8 @@ void ReplayRobot::scan(std::uint32_t command_id, const std::atomic<bool>& stop) 
   publisher_.scan(cloud, entry.pose, shot);
   publisher_.progress(command_id, "done", 1.0f, std::to_string(cloud.size()) + " points");
   publisher_.status(command_id, "idle", entry.pose);
-  spdlog::info("scan command {}: replayed {} ({} points)", command_id, entry.scan.filename().string(),
-               cloud.size());
+  spdlog::info("scan command {}: replayed {} ({} points)", command_id,
+               entry.scan.filename().string(), cloud.size());
 }
 
 }  // namespace scanplan::bridge

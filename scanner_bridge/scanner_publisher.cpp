@@ -18,7 +18,9 @@ std::int64_t now_ns() {
       .count();
 }
 
-char* c_str(const std::string& s) { return const_cast<char*>(s.c_str()); }
+char* c_str(const std::string& s) {
+  return const_cast<char*>(s.c_str());
+}
 
 }  // namespace
 
@@ -34,8 +36,8 @@ ScannerPublisher::ScannerPublisher(dds::Participant& p, std::string robot_id)
   status_ = p.writer(scanplan_RobotStatus_desc, topics::kRobotStatus, QosKind::kStatus);
 }
 
-void ScannerPublisher::progress(std::uint32_t command_id, const std::string& state,
-                                float fraction, const std::string& message) {
+void ScannerPublisher::progress(std::uint32_t command_id, const std::string& state, float fraction,
+                                const std::string& message) {
   scanplan_ScanProgress m{};
   m.robot_id = c_str(robot_id_);
   m.command_id = command_id;

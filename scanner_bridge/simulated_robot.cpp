@@ -67,8 +67,9 @@ void SimulatedRobot::scan(std::uint32_t command_id, const std::atomic<bool>& sto
   // against the wall clock makes the operator's progress bar move as the real scanner's would.
   const auto progress = [&](double fraction) {
     if (options_.time_scale > 0) {
-      std::this_thread::sleep_until(started + std::chrono::duration<double>(
-                                                  cfg.scan_duration_s * fraction / options_.time_scale));
+      std::this_thread::sleep_until(
+          started +
+          std::chrono::duration<double>(cfg.scan_duration_s * fraction / options_.time_scale));
     }
     if (fraction - last_reported >= 0.01 || fraction >= 1.0) {
       last_reported = static_cast<float>(fraction);
@@ -93,7 +94,8 @@ void SimulatedRobot::scan(std::uint32_t command_id, const std::atomic<bool>& sto
 
 void SimulatedRobot::move(const MoveRequest& goal, const std::atomic<bool>& stop) {
   const auto refuse = [&](const std::string& why) {
-    spdlog::warn("move command {} to ({:.2f}, {:.2f}) refused: {}", goal.command_id, goal.x, goal.y, why);
+    spdlog::warn("move command {} to ({:.2f}, {:.2f}) refused: {}", goal.command_id, goal.x, goal.y,
+                 why);
     publisher_.status(goal.command_id, "refused", reported_, why);
   };
   if (!std::isfinite(goal.x) || !std::isfinite(goal.y) || !std::isfinite(goal.yaw_deg)) {

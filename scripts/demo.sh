@@ -4,7 +4,7 @@
 set -euo pipefail
 build=${1:-build}
 port=${2:-8080}
-world=${WORLD:-samples/worlds/yard.json}
+world=${WORLD:-samples/worlds/campus.json}
 domain=${DOMAIN:-0}
 session=${SESSION:-demo-session}
 

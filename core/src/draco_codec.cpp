@@ -36,7 +36,8 @@ PointCloud decode_draco(std::string_view bytes) {
   buffer.Init(bytes.data(), bytes.size());
   draco::Decoder decoder;
   auto result = decoder.DecodePointCloudFromBuffer(&buffer);
-  if (!result.ok()) throw DracoError("not a Draco point cloud: " + result.status().error_msg_string());
+  if (!result.ok())
+    throw DracoError("not a Draco point cloud: " + result.status().error_msg_string());
   const std::unique_ptr<draco::PointCloud> pc = std::move(result).value();
   const draco::PointAttribute* pos = pc->GetNamedAttribute(draco::GeometryAttribute::POSITION);
   if (!pos || pos->num_components() != 3) throw DracoError("the Draco data has no 3-D positions");

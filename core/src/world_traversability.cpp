@@ -66,16 +66,16 @@ std::optional<std::size_t> WorldTraversability::cell_of(double x, double y) cons
 
 Eigen::Vector2d WorldTraversability::cell_center(std::size_t cell) const {
   const double cx = static_cast<double>(cell % cols_), cy = static_cast<double>(cell / cols_);
-  return world_.bounds_min + Eigen::Vector2d((cx + 0.5) * options_.cell_m, (cy + 0.5) * options_.cell_m);
+  return world_.bounds_min +
+         Eigen::Vector2d((cx + 0.5) * options_.cell_m, (cy + 0.5) * options_.cell_m);
 }
 
 WorldTraversability::Reach WorldTraversability::reach_from(double x, double y, double z) const {
   const auto start = cell_of(x, y);
   if (!start) throw std::invalid_argument("the start is outside the target region");
   const auto& s = surfaces_[*start];
-  const auto near = std::min_element(s.begin(), s.end(), [&](float a, float b) {
-    return std::abs(a - z) < std::abs(b - z);
-  });
+  const auto near = std::min_element(
+      s.begin(), s.end(), [&](float a, float b) { return std::abs(a - z) < std::abs(b - z); });
   if (near == s.end() || std::abs(*near - z) > 0.5) {
     throw std::invalid_argument("the start is not on a surface the robot can stand on");
   }
@@ -137,8 +137,10 @@ Pose WorldTraversability::standing_pose(double x, double y, double z, double yaw
     const auto hit = caster_.cast({px, py, z + 1.0}, {0, 0, -1}, 0.0, 2.0);
     return hit && !hit->exiting ? z + 1.0 - hit->range : z;
   };
-  const double gx = (height_at(x + kHalfBaseM, y) - height_at(x - kHalfBaseM, y)) / (2 * kHalfBaseM);
-  const double gy = (height_at(x, y + kHalfBaseM) - height_at(x, y - kHalfBaseM)) / (2 * kHalfBaseM);
+  const double gx =
+      (height_at(x + kHalfBaseM, y) - height_at(x - kHalfBaseM, y)) / (2 * kHalfBaseM);
+  const double gy =
+      (height_at(x, y + kHalfBaseM) - height_at(x, y - kHalfBaseM)) / (2 * kHalfBaseM);
   // The ground normal in the robot's yaw frame; Ry(pitch)·Rx(roll) must turn z onto it.
   const Eigen::Vector3d n =
       Eigen::AngleAxisd(-yaw, Eigen::Vector3d::UnitZ()) * Eigen::Vector3d(-gx, -gy, 1).normalized();

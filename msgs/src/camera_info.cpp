@@ -6,8 +6,8 @@
 
 namespace scanplan::dds {
 
-void to_camera_info(const PanoramaCamera& camera, const std::string& frame_id,
-                    std::int64_t stamp, OwnedCameraInfo& out) {
+void to_camera_info(const PanoramaCamera& camera, const std::string& frame_id, std::int64_t stamp,
+                    OwnedCameraInfo& out) {
   out.frame_id = frame_id;
   auto& m = out.msg;
   m = {};

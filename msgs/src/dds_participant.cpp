@@ -28,8 +28,10 @@ Participant::Participant(std::uint32_t domain_id) {
   }
   domain_ = dds_create_domain(domain_id, config.c_str());
   // Another participant in this process already made the domain: share its settings.
-  if (domain_ == DDS_RETCODE_PRECONDITION_NOT_MET) domain_ = 0;
-  else check(domain_, "creating DDS domain " + std::to_string(domain_id));
+  if (domain_ == DDS_RETCODE_PRECONDITION_NOT_MET)
+    domain_ = 0;
+  else
+    check(domain_, "creating DDS domain " + std::to_string(domain_id));
   participant_ = dds_create_participant(domain_id, nullptr, nullptr);
   if (participant_ < 0) {
     if (domain_ > 0) dds_delete(domain_);
@@ -80,15 +82,15 @@ std::unique_ptr<dds_qos_t, QosDeleter> make_qos(QosKind kind) {
 
 dds_entity_t Participant::writer(const dds_topic_descriptor_t& type, const std::string& name,
                                  QosKind qos) {
-  const dds_entity_t w = dds_create_writer(participant_, topic(type, name), make_qos(qos).get(),
-                                           nullptr);
+  const dds_entity_t w =
+      dds_create_writer(participant_, topic(type, name), make_qos(qos).get(), nullptr);
   return check(w, "creating a writer for " + name);
 }
 
 dds_entity_t Participant::reader(const dds_topic_descriptor_t& type, const std::string& name,
                                  QosKind qos) {
-  const dds_entity_t r = dds_create_reader(participant_, topic(type, name), make_qos(qos).get(),
-                                           nullptr);
+  const dds_entity_t r =
+      dds_create_reader(participant_, topic(type, name), make_qos(qos).get(), nullptr);
   return check(r, "creating a reader for " + name);
 }
 
@@ -100,7 +102,9 @@ ReadWaiter::ReadWaiter(dds_entity_t participant, std::initializer_list<dds_entit
   }
 }
 
-ReadWaiter::~ReadWaiter() { dds_delete(waitset_); }
+ReadWaiter::~ReadWaiter() {
+  dds_delete(waitset_);
+}
 
 bool ReadWaiter::wait(std::chrono::milliseconds timeout) {
   const dds_return_t n = dds_waitset_wait(waitset_, nullptr, 0, DDS_MSECS(timeout.count()));

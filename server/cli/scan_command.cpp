@@ -42,11 +42,12 @@ void run_scan(const ScanArgs& a) {
   // The same colourisation the server applies: from the panorama, not the world's colours.
   const ColorizeStats stats = colorize(shot->cloud, shot->panorama, shot->camera);
   char pose_comment[160];
-  std::snprintf(pose_comment, sizeof pose_comment, "scanplan true_pose %.6f %.6f %.6f %.6f",
-                pose.x, pose.y, pose.z, a.at[3]);
-  write_ply(a.out, shot->cloud,
-            {pose_comment, "scanplan world " + world.name, "scanplan seed " + std::to_string(a.seed),
-             "scanplan frame robot (origin on the ground under the scanner, x forward, z up)"});
+  std::snprintf(pose_comment, sizeof pose_comment, "scanplan true_pose %.6f %.6f %.6f %.6f", pose.x,
+                pose.y, pose.z, a.at[3]);
+  write_ply(
+      a.out, shot->cloud,
+      {pose_comment, "scanplan world " + world.name, "scanplan seed " + std::to_string(a.seed),
+       "scanplan frame robot (origin on the ground under the scanner, x forward, z up)"});
   if (!a.image.empty() && !cv::imwrite(a.image, shot->panorama)) {
     throw std::runtime_error("cannot write the panorama to " + a.image);
   }
@@ -69,7 +70,9 @@ void run_scan(const ScanArgs& a) {
 void add_scan_command(CLI::App& app) {
   auto args = std::make_shared<ScanArgs>();
   CLI::App* cmd = app.add_subcommand("scan", "one simulated scan of a world, written as PLY");
-  cmd->add_option("--world", args->world, "world file (JSON)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--world", args->world, "world file (JSON)")
+      ->required()
+      ->check(CLI::ExistingFile);
   cmd->add_option("--at", args->at, "where the robot stands: x,y,z,yaw_deg")
       ->required()
       ->delimiter(',')

@@ -13,7 +13,9 @@ using nlohmann::json;
 
 namespace {
 
-json vec3(const Eigen::Vector3f& v) { return json::array({v.x(), v.y(), v.z()}); }
+json vec3(const Eigen::Vector3f& v) {
+  return json::array({v.x(), v.y(), v.z()});
+}
 
 json pose_json(const Pose& p) {
   return {{"x", p.x}, {"y", p.y}, {"z", p.z}, {"yaw_deg", rad2deg(p.yaw)}};

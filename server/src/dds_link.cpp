@@ -20,7 +20,9 @@ constexpr std::size_t kMaxPartial = 8;
 constexpr auto kImageWait = std::chrono::seconds(2);
 constexpr auto kPartialExpiry = std::chrono::seconds(60);
 
-std::string str(const char* s) { return s ? s : ""; }
+std::string str(const char* s) {
+  return s ? s : "";
+}
 
 }  // namespace
 
@@ -41,7 +43,9 @@ DdsLink::DdsLink(std::uint32_t domain_id, ScanStore& store)
   scan_cmd_writer_ = p.writer(scanplan_ScanCommand_desc, topics::kScanCommand, QosKind::kCommand);
 }
 
-DdsLink::~DdsLink() { stop(); }
+DdsLink::~DdsLink() {
+  stop();
+}
 
 void DdsLink::start() {
   thread_ = std::thread([this] { loop(); });

@@ -1,7 +1,7 @@
 // scanplan-server: the operator workstation (DESIGN.md "Processes").
-#include <CLI/CLI.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
 
 #include <csignal>
 #include <cstdlib>
@@ -69,9 +69,8 @@ int main(int argc, char** argv) {
     http::Router router([](std::string_view msg) { spdlog::error("{}", msg); });
     api.install(router);
     const http::StaticFiles files(web_dir);
-    router.set_fallback([&files](const http::Request& r, const http::Router::Params&) {
-      return files.serve(r);
-    });
+    router.set_fallback(
+        [&files](const http::Request& r, const http::Router::Params&) { return files.serve(r); });
 
     http::HttpServer server(config, [&router](const http::Request& r) { return router.route(r); });
     server.start();
@@ -83,7 +82,8 @@ int main(int argc, char** argv) {
 
     const std::string url = "http://" + config.host + ":" + std::to_string(server.port()) + "/";
     std::cout << "scanplan-server listening on " << url << std::endl;
-    if (generated) std::cout << "operator link: " << url << "?token=" << operator_token << std::endl;
+    if (generated)
+      std::cout << "operator link: " << url << "?token=" << operator_token << std::endl;
     server.run();
     g_server = nullptr;
     dds.stop();

@@ -39,21 +39,24 @@ bool eventually(const std::function<bool()>& fn, std::chrono::milliseconds timeo
 class BridgeCommands : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    setenv("CYCLONEDDS_URI",
-           "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface "
-           "address=\"127.0.0.1\" multicast=\"true\"/></Interfaces></General></Domain></CycloneDDS>",
-           1);
+    setenv(
+        "CYCLONEDDS_URI",
+        "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface "
+        "address=\"127.0.0.1\" multicast=\"true\"/></Interfaces></General></Domain></CycloneDDS>",
+        1);
     // The yard with exact reported poses, so positions can be compared to the goals.
     nlohmann::json world;
     std::ifstream(SCANPLAN_SOURCE_DIR "/samples/worlds/yard.json") >> world;
     world["pose_noise"] = {{"xy_sigma_m", 0}, {"z_sigma_m", 0}, {"yaw_sigma_deg", 0}};
     world["scanner"] = {{"rotation_step_deg", 1.0}, {"camera_width_px", 512}};
-    world_file_ = new std::filesystem::path(std::filesystem::temp_directory_path() /
-                                            ("bridge_commands_" + std::to_string(getpid()) + ".json"));
+    world_file_ =
+        new std::filesystem::path(std::filesystem::temp_directory_path() /
+                                  ("bridge_commands_" + std::to_string(getpid()) + ".json"));
     std::ofstream(*world_file_) << world.dump();
 
-    bridge_ = new test::ChildProcess(SCANPLAN_BRIDGE, {"--world", world_file_->string(), "--domain",
-                                                       std::to_string(kDomain), "--time-scale", "200"});
+    bridge_ =
+        new test::ChildProcess(SCANPLAN_BRIDGE, {"--world", world_file_->string(), "--domain",
+                                                 std::to_string(kDomain), "--time-scale", "200"});
     participant_ = new dds::Participant(kDomain);
     using dds::QosKind;
     auto& p = *participant_;
@@ -63,8 +66,10 @@ class BridgeCommands : public ::testing::Test {
     status_ = p.reader(scanplan_RobotStatus_desc, topics::kRobotStatus, QosKind::kCommand);
     points_ = p.reader(sensor_msgs_msg_dds__PointCloud2__desc, topics::kPoints, QosKind::kScanData);
     pose_ = p.reader(geometry_msgs_msg_dds__PoseStamped__desc, topics::kPose, QosKind::kScanData);
-    image_ = p.reader(sensor_msgs_msg_dds__CompressedImage__desc, topics::kImage, QosKind::kScanData);
-    info_ = p.reader(sensor_msgs_msg_dds__CameraInfo__desc, topics::kCameraInfo, QosKind::kScanData);
+    image_ =
+        p.reader(sensor_msgs_msg_dds__CompressedImage__desc, topics::kImage, QosKind::kScanData);
+    info_ =
+        p.reader(sensor_msgs_msg_dds__CameraInfo__desc, topics::kCameraInfo, QosKind::kScanData);
     ASSERT_TRUE(dds::wait_for_reader(move_, 30s)) << "the bridge never subscribed to move commands";
     ASSERT_TRUE(dds::wait_for_reader(scan_, 30s));
   }
@@ -143,26 +148,28 @@ TEST_F(BridgeCommands, ScanBringsPanoramaCalibrationPoseAndPointsUnderOneStamp) 
   std::optional<PanoramaCamera> camera;
   std::vector<std::uint8_t> jpeg;
   std::set<std::int64_t> stamps;
-  ASSERT_TRUE(eventually([&] {
-    dds::take_all<sensor_msgs_msg_dds__PointCloud2_>(points_, [&](const auto& m) {
-      cloud = dds::unpack_pointcloud2(m);
-      stamps.insert(dds::stamp_ns(m.header.stamp));
-    });
-    dds::take_all<geometry_msgs_msg_dds__PoseStamped_>(pose_, [&](const auto& m) {
-      pose = dds::from_pose_stamped(m);
-      stamps.insert(dds::stamp_ns(m.header.stamp));
-    });
-    dds::take_all<sensor_msgs_msg_dds__CameraInfo_>(info_, [&](const auto& m) {
-      camera = dds::from_camera_info(m);
-      stamps.insert(dds::stamp_ns(m.header.stamp));
-    });
-    dds::take_all<sensor_msgs_msg_dds__CompressedImage_>(image_, [&](const auto& m) {
-      EXPECT_STREQ(m.format, "jpeg");
-      jpeg.assign(m.data._buffer, m.data._buffer + m.data._length);
-      stamps.insert(dds::stamp_ns(m.header.stamp));
-    });
-    return cloud && pose && camera && !jpeg.empty();
-  }, 60s));
+  ASSERT_TRUE(eventually(
+      [&] {
+        dds::take_all<sensor_msgs_msg_dds__PointCloud2_>(points_, [&](const auto& m) {
+          cloud = dds::unpack_pointcloud2(m);
+          stamps.insert(dds::stamp_ns(m.header.stamp));
+        });
+        dds::take_all<geometry_msgs_msg_dds__PoseStamped_>(pose_, [&](const auto& m) {
+          pose = dds::from_pose_stamped(m);
+          stamps.insert(dds::stamp_ns(m.header.stamp));
+        });
+        dds::take_all<sensor_msgs_msg_dds__CameraInfo_>(info_, [&](const auto& m) {
+          camera = dds::from_camera_info(m);
+          stamps.insert(dds::stamp_ns(m.header.stamp));
+        });
+        dds::take_all<sensor_msgs_msg_dds__CompressedImage_>(image_, [&](const auto& m) {
+          EXPECT_STREQ(m.format, "jpeg");
+          jpeg.assign(m.data._buffer, m.data._buffer + m.data._length);
+          stamps.insert(dds::stamp_ns(m.header.stamp));
+        });
+        return cloud && pose && camera && !jpeg.empty();
+      },
+      60s));
   EXPECT_EQ(stamps.size(), 1u) << "all parts of one scan carry the same stamp";
   EXPECT_NEAR(pose->x, -20, 1e-9);
   EXPECT_NEAR(pose->y, 10, 1e-9);

@@ -79,10 +79,13 @@ TEST_P(DracoRoundTrip, PositionsWithinQuantisationAndColoursExact) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sizes, DracoRoundTrip,
-                         ::testing::Values(RoundTripCase{1, 1.0f, 11}, RoundTripCase{1000, 12.0f, 11},
+                         ::testing::Values(RoundTripCase{1, 1.0f, 11},
+                                           RoundTripCase{1000, 12.0f, 11},
                                            RoundTripCase{20000, 200.0f, 14}));
 
-TEST(DracoCodec, EmptyCloudIsRefused) { EXPECT_THROW(encode_draco(PointCloud{}), DracoError); }
+TEST(DracoCodec, EmptyCloudIsRefused) {
+  EXPECT_THROW(encode_draco(PointCloud{}), DracoError);
+}
 
 TEST(DracoCodec, GarbageIsRefusedWithMessage) {
   try {

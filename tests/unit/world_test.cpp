@@ -22,8 +22,9 @@ void expect_error(const std::string& text, const std::string& fragment) {
 
 TEST(World, ParsesBoxesStartAndOverrides) {
   const World w = parse_world(
-      world_with(R"({"type": "box", "min": [0,0,0], "max": [1,2,3], "yaw_deg": 90, "color": [1,2,3]})",
-                 R"(, "scanner": {"max_range_m": 30}, "pose_noise": {"xy_sigma_m": 0})"),
+      world_with(
+          R"({"type": "box", "min": [0,0,0], "max": [1,2,3], "yaw_deg": 90, "color": [1,2,3]})",
+          R"(, "scanner": {"max_range_m": 30}, "pose_noise": {"xy_sigma_m": 0})"),
       "t.json");
   ASSERT_EQ(w.boxes.size(), 1u);
   EXPECT_DOUBLE_EQ(w.boxes[0].max.z(), 3.0);
@@ -46,14 +47,17 @@ TEST(World, ErrorsNameTheObjectAndField) {
                "field 'colour' is not a known field");
   expect_error(world_with(R"({"type": "box", "min": [0,0,0], "max": [1,2,3], "color": [1,1,300]})"),
                "within 0..255");
-  expect_error(world_with("", R"(, "scanner": {"min_range_m": 90})"), "scanner: field 'min_range_m'");
+  expect_error(world_with("", R"(, "scanner": {"min_range_m": 90})"),
+               "scanner: field 'min_range_m'");
   expect_error(world_with("", R"(, "extra": 1)"), "field 'extra' is not a known field");
   // JSON has no NaN literal: such a file is not valid JSON and says so.
-  expect_error(world_with(R"({"type": "box", "min": [NaN,0,0], "max": [1,2,3]})"), "not valid JSON");
+  expect_error(world_with(R"({"type": "box", "min": [NaN,0,0], "max": [1,2,3]})"),
+               "not valid JSON");
 }
 
 TEST(World, ShippedSampleWorldsLoad) {
-  for (const auto& entry : std::filesystem::directory_iterator(SCANPLAN_SOURCE_DIR "/samples/worlds")) {
+  for (const auto& entry :
+       std::filesystem::directory_iterator(SCANPLAN_SOURCE_DIR "/samples/worlds")) {
     SCOPED_TRACE(entry.path().string());
     EXPECT_NO_THROW(load_world(entry.path()));
   }

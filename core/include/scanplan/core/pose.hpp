@@ -15,7 +15,11 @@ struct Pose {
   Eigen::Quaterniond orientation() const;
 };
 
-constexpr double deg2rad(double d) { return d * 0.017453292519943295; }
-constexpr double rad2deg(double r) { return r * 57.29577951308232; }
+constexpr double deg2rad(double d) {
+  return d * 0.017453292519943295;
+}
+constexpr double rad2deg(double r) {
+  return r * 57.29577951308232;
+}
 
 }  // namespace scanplan

@@ -13,7 +13,7 @@ struct TraversabilityOptions {
   double cell_m = 0.5;
   // Largest height difference between neighbouring cells the robot climbs (paper §3.2: 0.15 m).
   double max_step_m = 0.15;
-  double clearance_m = 1.6;   // free height the robot needs above a surface to stand there
+  double clearance_m = 1.6;    // free height the robot needs above a surface to stand there
   double min_normal_z = 0.85;  // steeper than about 32° is a wall, not a floor
 };
 
