@@ -1,5 +1,7 @@
 #include "scanplan/core/world.hpp"
 
+#include "scanplan/core/target_region.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -291,23 +293,7 @@ double World::ground_height(double x, double y) const {
 bool World::in_target_region(double x, double y) const {
   if (x < bounds_min.x() || x > bounds_max.x() || y < bounds_min.y() || y > bounds_max.y())
     return false;
-  if (bounds_polygon.empty()) return true;
-  // Even-odd crossing count along +x; a point on an edge is inside, checked first because the
-  // crossing count alone decides edge points by accident of rounding.
-  bool inside = false;
-  const std::size_t n = bounds_polygon.size();
-  for (std::size_t i = 0, j = n - 1; i < n; j = i++) {
-    const Eigen::Vector2d& a = bounds_polygon[i];
-    const Eigen::Vector2d& b = bounds_polygon[j];
-    const double cross = (b.x() - a.x()) * (y - a.y()) - (b.y() - a.y()) * (x - a.x());
-    const bool within = std::min(a.x(), b.x()) <= x && x <= std::max(a.x(), b.x()) &&
-                        std::min(a.y(), b.y()) <= y && y <= std::max(a.y(), b.y());
-    if (within && std::abs(cross) <= 1e-12 * ((b - a).squaredNorm() + 1)) return true;
-    if ((a.y() > y) != (b.y() > y) && x < a.x() + (y - a.y()) * (b.x() - a.x()) / (b.y() - a.y())) {
-      inside = !inside;
-    }
-  }
-  return inside;
+  return bounds_polygon.empty() || polygon_contains(bounds_polygon, x, y);
 }
 
 World parse_world(const std::string& json_text, const std::string& source_name) {

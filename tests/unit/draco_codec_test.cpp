@@ -49,7 +49,9 @@ TEST_P(DracoRoundTrip, PositionsWithinQuantisationAndColoursExact) {
   const std::string bytes = encode_draco(in, options);
   // Header overhead dominates tiny clouds; from a thousand points on Draco must beat raw
   // float xyz + rgb8 (15 bytes a point).
-  if (n >= 1000) EXPECT_LT(bytes.size(), n * 15);
+  if (n >= 1000) {
+    EXPECT_LT(bytes.size(), n * 15);
+  }
 
   PointCloud out = decode_draco(bytes);
   ASSERT_EQ(out.size(), in.size());
