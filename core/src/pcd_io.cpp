@@ -3,13 +3,13 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <charconv>
 #include <cstdint>
-#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <optional>
 #include <vector>
+
+#include "text_scan.hpp"
 
 namespace scanplan {
 namespace {
@@ -71,93 +71,37 @@ bool lzf_decompress(std::string_view in, std::vector<char>& out) {
   return op == out.size();
 }
 
-class Parser {
+class Parser : private text_scan::LineReader {
  public:
-  Parser(std::string_view bytes, const std::string& source) : bytes_(bytes), source_(source) {}
+  using LineReader::LineReader;
 
   PointCloud parse(PcdInfo* info);
 
  private:
-  [[noreturn]] void fail(const std::string& what) const {
-    throw ScanFileError(source_ + ": " + what);
-  }
-  [[noreturn]] void fail_line(std::size_t line, const std::string& what) const {
-    fail("line " + std::to_string(line) + ": " + what);
-  }
-
-  bool next_line(std::string_view& line) {
-    if (pos_ >= bytes_.size()) return false;
-    const std::size_t end = bytes_.find('\n', pos_);
-    const std::size_t stop = end == std::string_view::npos ? bytes_.size() : end;
-    line = bytes_.substr(pos_, stop - pos_);
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    pos_ = end == std::string_view::npos ? bytes_.size() : end + 1;
-    ++line_;
-    return true;
-  }
-
   Header parse_header();
   Layout layout_of(const Header& h) const;
   void read_ascii(const Header& h, const Layout& l, PointCloud& cloud, std::size_t& dropped);
   void read_binary(const Header& h, const Layout& l, PointCloud& cloud, std::size_t& dropped);
   void read_compressed(const Header& h, const Layout& l, PointCloud& cloud, std::size_t& dropped);
-
-  std::string_view bytes_;
-  const std::string& source_;
-  std::size_t pos_ = 0;
-  std::size_t line_ = 0;
 };
-
-std::vector<std::string_view> split_ws(std::string_view s) {
-  std::vector<std::string_view> out;
-  std::size_t i = 0;
-  while (i < s.size()) {
-    while (i < s.size() && (s[i] == ' ' || s[i] == '\t')) ++i;
-    std::size_t j = i;
-    while (j < s.size() && s[j] != ' ' && s[j] != '\t') ++j;
-    if (j > i) out.push_back(s.substr(i, j - i));
-    i = j;
-  }
-  return out;
-}
-
-template <typename T>
-bool parse_int(std::string_view s, T& out) {
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-  return ec == std::errc() && p == s.data() + s.size();
-}
-
-bool parse_double(std::string_view s, double& out) {
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-  if (p != s.data() + s.size()) return false;
-  if (ec == std::errc::result_out_of_range) {
-    // from_chars leaves `out` alone here; strtod gives ±HUGE_VAL or 0, and the non-finite
-    // filter then decides.
-    out = std::strtod(std::string(s).c_str(), nullptr);
-    return true;
-  }
-  return ec == std::errc();
-}
 
 // PCL has written ascii rgb both as the float whose bits are the colour (old) and as the
 // integer itself (since 1.8, because some colours are NaN as floats); accept either.
 bool parse_rgb_token(std::string_view s, char type, std::uint32_t& bits) {
   std::uint32_t u = 0;
-  if (parse_int(s, u)) {
+  if (text_scan::parse_int(s, u)) {
     bits = u;
     return true;
   }
   if (type == 'I') {
     std::int32_t i = 0;
-    if (!parse_int(s, i)) return false;
+    if (!text_scan::parse_int(s, i)) return false;
     bits = static_cast<std::uint32_t>(i);
     return true;
   }
   if (type != 'F') return false;
   double d = 0;
-  if (!parse_double(s, d)) return false;
+  if (!text_scan::parse_double(s, d)) return false;
   const auto f = static_cast<float>(d);
   std::memcpy(&bits, &f, sizeof bits);
   return true;
@@ -201,12 +145,12 @@ Header Parser::parse_header() {
     if (!next_line(line)) {
       fail("the header has no 'DATA' line (the file is truncated or not a PCD file)");
     }
-    const auto tok = split_ws(line);
+    const auto tok = text_scan::split_ws(line);
     if (tok.empty() || tok[0].front() == '#') continue;
     const std::string_view key = tok[0];
     const auto args = std::vector<std::string_view>(tok.begin() + 1, tok.end());
     auto parse_count_line = [&](std::uint64_t& out) {
-      if (args.size() != 1 || !parse_int(args[0], out)) {
+      if (args.size() != 1 || !text_scan::parse_int(args[0], out)) {
         fail_line(line_, "'" + std::string(key) + "' needs one non-negative integer");
       }
     };
@@ -220,7 +164,7 @@ Header Parser::parse_header() {
       once(have_size, key);
       for (const auto a : args) {
         std::size_t s = 0;
-        if (!parse_int(a, s) || (s != 1 && s != 2 && s != 4 && s != 8)) {
+        if (!text_scan::parse_int(a, s) || (s != 1 && s != 2 && s != 4 && s != 8)) {
           fail_line(line_, "SIZE '" + std::string(a) + "' is not 1, 2, 4 or 8");
         }
         sizes.push_back(s);
@@ -238,7 +182,7 @@ Header Parser::parse_header() {
       for (const auto a : args) {
         std::size_t c = 0;
         // The longest descriptors PCL knows have a few hundred values; a million is a lie.
-        if (!parse_int(a, c) || c == 0 || c > (1u << 20)) {
+        if (!text_scan::parse_int(a, c) || c == 0 || c > (1u << 20)) {
           fail_line(line_, "COUNT '" + std::string(a) + "' is not an integer from 1 to 1048576");
         }
         counts.push_back(c);
@@ -256,7 +200,7 @@ Header Parser::parse_header() {
       once(have_viewpoint, key);
       if (args.size() != 7) fail_line(line_, "VIEWPOINT needs 7 numbers: tx ty tz qw qx qy qz");
       for (std::size_t i = 0; i < 7; ++i) {
-        if (!parse_double(args[i], h.viewpoint[i])) {
+        if (!text_scan::parse_double(args[i], h.viewpoint[i])) {
           fail_line(line_, "VIEWPOINT value '" + std::string(args[i]) + "' is not a number");
         }
       }
@@ -458,7 +402,7 @@ void Parser::read_ascii(const Header& h, const Layout& l, PointCloud& cloud, std
       fail("the data ends after " + std::to_string(i) + " of " + std::to_string(n) +
            " points (the file is truncated or the count is wrong)");
     }
-    const auto tok = split_ws(line);
+    const auto tok = text_scan::split_ws(line);
     if (tok.empty()) continue;
     if (tok.size() != l.values_per_point) {
       fail_line(line_, "point " + std::to_string(i) + " has " + std::to_string(tok.size()) +
@@ -470,7 +414,7 @@ void Parser::read_ascii(const Header& h, const Layout& l, PointCloud& cloud, std
     for (std::size_t a = 0; a < 3; ++a) {
       const std::string_view v = tok[l.value_offset[l.xyz[a]]];
       double d = 0;
-      if (!parse_double(v, d)) {
+      if (!text_scan::parse_double(v, d)) {
         fail_line(line_, "field '" + h.fields[l.xyz[a]].name + "': '" +
                              std::string(v.substr(0, 40)) + "' is not a number");
       }
@@ -494,7 +438,7 @@ void Parser::read_ascii(const Header& h, const Layout& l, PointCloud& cloud, std
     if (l.rgb) cloud.colors.push_back(rgb);
   }
   while (next_line(line)) {
-    if (!split_ws(line).empty()) {
+    if (!text_scan::split_ws(line).empty()) {
       fail_line(line_, "more point lines than the header's POINTS " + std::to_string(n));
     }
   }
@@ -525,12 +469,6 @@ PointCloud Parser::parse(PcdInfo* info) {
     info->dropped_non_finite = dropped;
   }
   return cloud;
-}
-
-void append_text(std::string& out, float v) {
-  std::array<char, 32> buf;
-  const auto [end, ec] = std::to_chars(buf.data(), buf.data() + buf.size(), v);
-  out.append(buf.data(), ec == std::errc() ? end : buf.data());
 }
 
 }  // namespace
@@ -567,11 +505,11 @@ std::string write_pcd_bytes(const PointCloud& cloud, bool binary) {
       if (colors) append_le(out, bits);
       continue;
     }
-    append_text(out, p.x());
+    text_scan::append_text(out, p.x());
     out += ' ';
-    append_text(out, p.y());
+    text_scan::append_text(out, p.y());
     out += ' ';
-    append_text(out, p.z());
+    text_scan::append_text(out, p.z());
     // The colour as the integer, as PCL writes it: as a float it can be NaN or denormal.
     if (colors) out += ' ' + std::to_string(bits);
     out += '\n';

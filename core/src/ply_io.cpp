@@ -3,14 +3,14 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <cstring>
 #include <optional>
 #include <stdexcept>
 #include <utility>
+
+#include "text_scan.hpp"
 
 namespace scanplan {
 namespace {
@@ -87,35 +87,20 @@ struct Header {
   std::size_t line_count = 0;   // so that ascii body line numbers match a text editor's
 };
 
-// Which output a vertex property feeds.
-enum class Role { kSkip, kX, kY, kZ, kRed, kGreen, kBlue };
+// Which output a vertex property feeds: coordinate `index` (x, y, z), colour channel `index`
+// (red, green, blue), or neither.
+struct Role {
+  enum Output { kSkip, kXyz, kRgb } output = kSkip;
+  std::size_t index = 0;
+};
 
-class Parser {
+class Parser : private text_scan::LineReader {
  public:
-  Parser(std::string_view bytes, const std::string& source) : bytes_(bytes), source_(source) {}
+  using LineReader::LineReader;
 
   PointCloud parse(PlyInfo* info);
 
  private:
-  [[noreturn]] void fail(const std::string& what) const {
-    throw ScanFileError(source_ + ": " + what);
-  }
-  [[noreturn]] void fail_line(std::size_t line, const std::string& what) const {
-    fail("line " + std::to_string(line) + ": " + what);
-  }
-
-  // The next line from `pos_` without its line break; false at the end of the bytes.
-  bool next_line(std::string_view& line) {
-    if (pos_ >= bytes_.size()) return false;
-    const std::size_t end = bytes_.find('\n', pos_);
-    const std::size_t stop = end == std::string_view::npos ? bytes_.size() : end;
-    line = bytes_.substr(pos_, stop - pos_);
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    pos_ = end == std::string_view::npos ? bytes_.size() : end + 1;
-    ++line_;
-    return true;
-  }
-
   Header parse_header();
   std::vector<Role> vertex_roles(const Element& vertex, bool& has_color) const;
   void skip_binary(const Element& e, bool swap);
@@ -124,54 +109,12 @@ class Parser {
                             bool has_color, PointCloud& cloud, std::size_t& dropped);
   void read_ascii_vertices(const Element& e, const std::vector<Role>& roles, bool has_color,
                            PointCloud& cloud, std::size_t& dropped);
-
-  std::string_view bytes_;
-  const std::string& source_;
-  std::size_t pos_ = 0;
-  std::size_t line_ = 0;
 };
-
-std::vector<std::string_view> split_ws(std::string_view s) {
-  std::vector<std::string_view> out;
-  std::size_t i = 0;
-  while (i < s.size()) {
-    while (i < s.size() && (s[i] == ' ' || s[i] == '\t')) ++i;
-    std::size_t j = i;
-    while (j < s.size() && s[j] != ' ' && s[j] != '\t') ++j;
-    if (j > i) out.push_back(s.substr(i, j - i));
-    i = j;
-  }
-  return out;
-}
 
 // The text after a keyword and its one separating blank, kept verbatim so comments round-trip.
 std::string rest_after(std::string_view line, std::string_view keyword) {
   if (line.size() <= keyword.size() + 1) return {};
   return std::string(line.substr(keyword.size() + 1));
-}
-
-bool parse_u64(std::string_view s, std::uint64_t& out) {
-  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-  return ec == std::errc() && p == s.data() + s.size();
-}
-
-bool parse_i64(std::string_view s, std::int64_t& out) {
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-  return ec == std::errc() && p == s.data() + s.size();
-}
-
-bool parse_double(std::string_view s, double& out) {
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-  if (p != s.data() + s.size()) return false;
-  if (ec == std::errc::result_out_of_range) {
-    // from_chars leaves `out` alone here; strtod gives ±HUGE_VAL or 0 as a text reader would,
-    // and the non-finite filter then decides.
-    out = std::strtod(std::string(s).c_str(), nullptr);
-    return true;
-  }
-  return ec == std::errc();
 }
 
 template <typename T>
@@ -228,7 +171,7 @@ Header Parser::parse_header() {
     if (!next_line(line)) {
       fail("the header has no 'end_header' line (the file is truncated or not a PLY file)");
     }
-    const auto tok = split_ws(line);
+    const auto tok = text_scan::split_ws(line);
     if (tok.empty()) continue;
     const std::string_view key = tok[0];
     if (key == "end_header") {
@@ -257,7 +200,8 @@ Header Parser::parse_header() {
       if (tok.size() != 3) fail_line(line_, "expected 'element <name> <count>'");
       Element e;
       e.name = tok[1];
-      if (!parse_u64(tok[2], e.count)) {
+      // Unlike the values in an ascii body, a count may not carry a '+'.
+      if (tok[2].starts_with('+') || !text_scan::parse_int(tok[2], e.count)) {
         fail_line(line_, "element '" + e.name + "' count '" + std::string(tok[2]) +
                              "' is not a non-negative integer");
       }
@@ -308,7 +252,7 @@ Header Parser::parse_header() {
 }
 
 std::vector<Role> Parser::vertex_roles(const Element& vertex, bool& has_color) const {
-  std::vector<Role> roles(vertex.properties.size(), Role::kSkip);
+  std::vector<Role> roles(vertex.properties.size());
   auto find = [&](std::string_view name) -> std::optional<std::size_t> {
     for (std::size_t i = 0; i < vertex.properties.size(); ++i) {
       if (vertex.properties[i].name == name) return i;
@@ -321,9 +265,9 @@ std::vector<Role> Parser::vertex_roles(const Element& vertex, bool& has_color) c
     return names.empty() ? std::string("none") : names;
   };
 
-  const std::array<std::pair<const char*, Role>, 3> xyz{
-      {{"x", Role::kX}, {"y", Role::kY}, {"z", Role::kZ}}};
-  for (const auto& [name, role] : xyz) {
+  static constexpr std::array<const char*, 3> kAxisNames{"x", "y", "z"};
+  for (std::size_t a = 0; a < 3; ++a) {
+    const char* name = kAxisNames[a];
     const auto i = find(name);
     if (!i) {
       fail("the vertex element has no '" + std::string(name) +
@@ -333,7 +277,7 @@ std::vector<Role> Parser::vertex_roles(const Element& vertex, bool& has_color) c
     if (p.is_list || is_integer(p.type)) {
       fail("vertex property '" + p.name + "' must be a float or double scalar");
     }
-    roles[*i] = role;
+    roles[*i] = {Role::kXyz, a};
   }
 
   // Writers disagree on colour names; take the first naming of which any part is present.
@@ -356,7 +300,7 @@ std::vector<Role> Parser::vertex_roles(const Element& vertex, bool& has_color) c
       if (p.is_list || p.type != ScalarType::kUint8) {
         fail("vertex property '" + p.name + "' must be uchar (0-255) to be read as a colour");
       }
-      roles[*idx[c]] = c == 0 ? Role::kRed : (c == 1 ? Role::kGreen : Role::kBlue);
+      roles[*idx[c]] = {Role::kRgb, c};
     }
     has_color = true;
     break;
@@ -412,8 +356,22 @@ void Parser::skip_ascii(const Element& e) {
       fail("the data ends after " + std::to_string(i) + " of " + std::to_string(e.count) + " '" +
            e.name + "' items");
     }
-    if (!split_ws(line).empty()) ++i;
+    if (!text_scan::split_ws(line).empty()) ++i;
   }
+}
+
+// Adds a vertex read as doubles to `cloud`, or counts it in `dropped` if it is not finite as
+// floats.
+void add_vertex(const std::array<double, 3>& xyz, const Rgb& rgb, bool has_color, PointCloud& cloud,
+                std::size_t& dropped) {
+  const Eigen::Vector3f pt(static_cast<float>(xyz[0]), static_cast<float>(xyz[1]),
+                           static_cast<float>(xyz[2]));
+  if (!pt.allFinite()) {
+    ++dropped;
+    return;
+  }
+  cloud.points.push_back(pt);
+  if (has_color) cloud.colors.push_back(rgb);
 }
 
 void Parser::read_binary_vertices(const Element& e, const std::vector<Role>& roles, bool swap,
@@ -457,32 +415,15 @@ void Parser::read_binary_vertices(const Element& e, const std::vector<Role>& rol
       }
       if (size_of(p.type) > left) fail("the data ends inside vertex " + std::to_string(i));
       const char* at = bytes_.data() + pos_;
-      switch (roles[k]) {
-        case Role::kSkip:
-          break;
-        case Role::kX:
-        case Role::kY:
-        case Role::kZ:
-          xyz[static_cast<int>(roles[k]) - static_cast<int>(Role::kX)] =
-              load_scalar(at, p.type, swap);
-          break;
-        case Role::kRed:
-        case Role::kGreen:
-        case Role::kBlue:
-          rgb[static_cast<int>(roles[k]) - static_cast<int>(Role::kRed)] =
-              static_cast<std::uint8_t>(*at);
-          break;
+      const Role role = roles[k];
+      if (role.output == Role::kXyz) {
+        xyz[role.index] = load_scalar(at, p.type, swap);
+      } else if (role.output == Role::kRgb) {
+        rgb[role.index] = static_cast<std::uint8_t>(*at);
       }
       pos_ += size_of(p.type);
     }
-    const Eigen::Vector3f pt(static_cast<float>(xyz[0]), static_cast<float>(xyz[1]),
-                             static_cast<float>(xyz[2]));
-    if (!pt.allFinite()) {
-      ++dropped;
-      continue;
-    }
-    cloud.points.push_back(pt);
-    if (has_color) cloud.colors.push_back(rgb);
+    add_vertex(xyz, rgb, has_color, cloud, dropped);
   }
 }
 
@@ -508,7 +449,7 @@ void Parser::read_ascii_vertices(const Element& e, const std::vector<Role>& role
       fail("the data ends after " + std::to_string(i) + " of " + std::to_string(n) +
            " vertices (the file is truncated or the count is wrong)");
     }
-    const auto tok = split_ws(line);
+    const auto tok = text_scan::split_ws(line);
     if (tok.empty()) continue;
     std::size_t t = 0;
     auto value_count_error = [&] {
@@ -520,7 +461,7 @@ void Parser::read_ascii_vertices(const Element& e, const std::vector<Role>& role
       if (t >= tok.size()) value_count_error();
       if (p.is_list) {
         std::int64_t count = 0;
-        if (!parse_i64(tok[t], count) || count < 0) {
+        if (!text_scan::parse_int(tok[t], count) || count < 0) {
           fail_line(line_, "list length '" + std::string(tok[t]) + "' of property '" + p.name +
                                "' is not a non-negative integer");
         }
@@ -530,41 +471,24 @@ void Parser::read_ascii_vertices(const Element& e, const std::vector<Role>& role
         continue;
       }
       const std::string_view v = tok[t++];
-      switch (roles[k]) {
-        case Role::kSkip:
-          break;
-        case Role::kX:
-        case Role::kY:
-        case Role::kZ:
-          if (!parse_double(v, xyz[static_cast<int>(roles[k]) - static_cast<int>(Role::kX)])) {
-            fail_line(line_, "vertex " + std::to_string(i) + " property '" + p.name + "': '" +
-                                 std::string(v.substr(0, 40)) + "' is not a number");
-          }
-          break;
-        case Role::kRed:
-        case Role::kGreen:
-        case Role::kBlue: {
-          std::int64_t c = 0;
-          if (!parse_i64(v, c) || c < 0 || c > 255) {
-            fail_line(line_, "vertex " + std::to_string(i) + " colour '" + p.name + "': '" +
-                                 std::string(v.substr(0, 40)) + "' is not an integer 0-255");
-          }
-          rgb[static_cast<int>(roles[k]) - static_cast<int>(Role::kRed)] =
-              static_cast<std::uint8_t>(c);
-          break;
+      const Role role = roles[k];
+      if (role.output == Role::kXyz) {
+        if (!text_scan::parse_double(v, xyz[role.index])) {
+          fail_line(line_, "vertex " + std::to_string(i) + " property '" + p.name + "': '" +
+                               std::string(v.substr(0, 40)) + "' is not a number");
         }
+      } else if (role.output == Role::kRgb) {
+        std::int64_t c = 0;
+        if (!text_scan::parse_int(v, c) || c < 0 || c > 255) {
+          fail_line(line_, "vertex " + std::to_string(i) + " colour '" + p.name + "': '" +
+                               std::string(v.substr(0, 40)) + "' is not an integer 0-255");
+        }
+        rgb[role.index] = static_cast<std::uint8_t>(c);
       }
     }
     if (t != tok.size()) value_count_error();
     ++i;
-    const Eigen::Vector3f pt(static_cast<float>(xyz[0]), static_cast<float>(xyz[1]),
-                             static_cast<float>(xyz[2]));
-    if (!pt.allFinite()) {
-      ++dropped;
-      continue;
-    }
-    cloud.points.push_back(pt);
-    if (has_color) cloud.colors.push_back(rgb);
+    add_vertex(xyz, rgb, has_color, cloud, dropped);
   }
 }
 
@@ -620,12 +544,6 @@ void append_binary(std::string& out, T v, bool swap) {
   out.append(buf.data(), buf.size());
 }
 
-void append_text(std::string& out, float v) {
-  std::array<char, 32> buf;
-  const auto [end, ec] = std::to_chars(buf.data(), buf.data() + buf.size(), v);
-  out.append(buf.data(), ec == std::errc() ? end : buf.data());
-}
-
 }  // namespace
 
 PointCloud read_ply_bytes(std::string_view bytes, const std::string& source_name, PlyInfo* info) {
@@ -658,11 +576,11 @@ std::string write_ply_bytes(const PointCloud& cloud, const std::vector<std::stri
     out.reserve(out.size() + cloud.size() * (colors ? 48 : 36));
     for (std::size_t i = 0; i < cloud.size(); ++i) {
       const auto& p = cloud.points[i];
-      append_text(out, p.x());
+      text_scan::append_text(out, p.x());
       out += ' ';
-      append_text(out, p.y());
+      text_scan::append_text(out, p.y());
       out += ' ';
-      append_text(out, p.z());
+      text_scan::append_text(out, p.z());
       if (colors) {
         for (const std::uint8_t c : cloud.colors[i]) {
           out += ' ';

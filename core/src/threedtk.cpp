@@ -2,30 +2,17 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 #include <cmath>
-#include <cstdlib>
 #include <vector>
+
+#include "text_scan.hpp"
 
 namespace scanplan {
 namespace {
 
-[[noreturn]] void fail(const std::string& source, const std::string& what) {
-  throw ScanFileError(source + ": " + what);
-}
-
-bool parse_double(std::string_view s, double& out) {
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-  if (p != s.data() + s.size()) return false;
-  if (ec == std::errc::result_out_of_range) {
-    // from_chars leaves `out` alone here; strtod gives ±HUGE_VAL or 0 as 3DTK's own reader
-    // would, and the non-finite filter then decides.
-    out = std::strtod(std::string(s).c_str(), nullptr);
-    return true;
-  }
-  return ec == std::errc();
-}
+using text_scan::fail;
+using text_scan::fail_line;
+using text_scan::parse_double;
 
 bool is_space(char c) {
   return c == ' ' || c == '\t' || c == '\r' || c == '\n';
@@ -51,14 +38,14 @@ Numbers numbers_of(std::string_view text, const std::string& source, std::size_t
     while (j < text.size() && !is_space(text[j])) ++j;
     const std::string_view tok = text.substr(i, j - i);
     if (n.values.size() == max_count) {
-      fail(source, "line " + std::to_string(line) + ": unexpected '" +
-                       std::string(tok.substr(0, 40)) + "' after " + std::to_string(max_count) +
-                       " numbers");
+      fail_line(source, line,
+                "unexpected '" + std::string(tok.substr(0, 40)) + "' after " +
+                    std::to_string(max_count) + " numbers");
     }
     double v = 0;
     if (!parse_double(tok, v) || !std::isfinite(v)) {
-      fail(source, "line " + std::to_string(line) + ": '" + std::string(tok.substr(0, 40)) +
-                       "' is not a finite number");
+      const std::string shown(tok.substr(0, 40));
+      fail_line(source, line, "'" + shown + "' is not a finite number");
     }
     n.values.push_back(v);
     n.lines.push_back(line);
@@ -97,15 +84,10 @@ PointCloud parse_threedtk_scan(std::string_view text, const std::string& source_
   const double min_range_cm = options.min_range_m * 100.0;
   const double max_range_cm = options.max_range_m * 100.0;
 
-  std::size_t line_no = 0;
-  std::size_t pos = 0;
+  text_scan::LineReader reader(text, source_name);
+  std::string_view line;
   std::array<std::string_view, 4> tok;
-  while (pos < text.size()) {
-    const std::size_t end = std::min(text.find('\n', pos), text.size());
-    const std::string_view line = text.substr(pos, end - pos);
-    pos = end + 1;
-    ++line_no;
-
+  while (reader.next_line(line)) {
     std::size_t count = 0;
     for (std::size_t i = 0; i < line.size();) {
       if (is_space(line[i])) {
@@ -120,16 +102,15 @@ PointCloud parse_threedtk_scan(std::string_view text, const std::string& source_
     }
     if (count == 0) continue;
     if (count != 3) {
-      fail(source_name, "line " + std::to_string(line_no) +
-                            ": expected 3 numbers 'x y z' (cm), got " + std::to_string(count) +
-                            " values");
+      fail_line(source_name, reader.line_number(),
+                "expected 3 numbers 'x y z' (cm), got " + std::to_string(count) + " values");
     }
     ++stats.lines;
     Eigen::Vector3d p;
     for (int a = 0; a < 3; ++a) {
       if (!parse_double(tok[a], p[a])) {
-        fail(source_name, "line " + std::to_string(line_no) + ": '" +
-                              std::string(tok[a].substr(0, 40)) + "' is not a number");
+        const std::string shown(tok[a].substr(0, 40));
+        fail_line(source_name, reader.line_number(), "'" + shown + "' is not a number");
       }
     }
     if (!p.allFinite()) {

@@ -1,5 +1,6 @@
 #include "api.hpp"
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include "http/http_error.hpp"
@@ -49,6 +50,10 @@ void Api::install(http::Router& router) {
     require(r, Role::kViewer);
     return map_drc(r);
   });
+  router.add("GET", "/api/v1/layers/{layer}.png", [this](const Request& r, const auto& params) {
+    require(r, Role::kViewer);
+    return layer(params.at("layer"));
+  });
   router.add("POST", "/api/v1/scan", [this](const Request& r, const auto&) {
     require(r, Role::kOperator);
     return request_scan(r);
@@ -90,6 +95,11 @@ Response Api::session() const {
             {"points", store_.point_count()},
             {"bridges", dds_.connected_bridges()},
             {"robots", robots}};
+  const MapAreas areas = store_.areas();
+  j["areas"] = {{"completed_m2", areas.completed_m2},
+                {"low_resolution_m2", areas.low_resolution_m2},
+                {"unscanned_m2", areas.unscanned_m2},
+                {"movable_m2", areas.movable_m2}};
   if (!scans.empty()) {
     const Bounds3 b = store_.bounds();
     j["bounds"] = {{"min", vec3(b.min)}, {"max", vec3(b.max)}};
@@ -109,6 +119,23 @@ Response Api::map_drc(const Request&) const {
     return empty;
   }
   Response r = Response::bytes(*encoded, "application/octet-stream");
+  r.set_header("Cache-Control", "no-store");
+  return r;
+}
+
+Response Api::layer(const std::string& name) const {
+  const auto& names = ScanStore::layer_names();
+  if (std::find(names.begin(), names.end(), name) == names.end()) {
+    throw HttpError(404, "unknown_layer",
+                    "no layer '" + name + "'; the layers are regions, elevation and movable");
+  }
+  const auto png = store_.layer_png(name);
+  if (!png) {
+    Response empty;
+    empty.status = 204;
+    return empty;
+  }
+  Response r = Response::bytes(std::string(png->begin(), png->end()), "image/png");
   r.set_header("Cache-Control", "no-store");
   return r;
 }

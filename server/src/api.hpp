@@ -24,6 +24,7 @@ class Api {
   http::Response health() const;
   http::Response session() const;
   http::Response map_drc(const http::Request& request) const;
+  http::Response layer(const std::string& name) const;
   http::Response request_scan(const http::Request& request);
 
   ScanStore& store_;

@@ -1,8 +1,16 @@
 #include "scan_store.hpp"
 
 #include "scanplan/core/draco_codec.hpp"
+#include "scanplan/core/top_view.hpp"
 
 namespace scanplan::server {
+
+ScanStore::ScanStore(PipelineConfig pipeline) : pipeline_(pipeline) {}
+
+const std::vector<std::string>& ScanStore::layer_names() {
+  static const std::vector<std::string> kNames = {"regions", "elevation", "movable"};
+  return kNames;
+}
 
 ScanRecord ScanStore::add(const std::string& robot_id, const Pose& pose, std::int64_t stamp_ns,
                           const PointCloud& cloud) {
@@ -31,10 +39,29 @@ ScanRecord ScanStore::add(const std::string& robot_id, const Pose& pose, std::in
   record.points = placed.size();
   std::shared_ptr<const std::string> encoded;
   if (!next.empty()) encoded = std::make_shared<const std::string>(encode_draco(next));
+
+  pipeline_.add_scan(cloud, pose);
+  std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> layers;
+  MapAreas areas;
+  if (pipeline_.regions() && pipeline_.movable()) {
+    const RegionMap& regions = *pipeline_.regions();
+    const MovableRegion& movable = *pipeline_.movable();
+    const auto png = [](const cv::Mat& img) {
+      return std::make_shared<const std::vector<std::uint8_t>>(encode_png(img));
+    };
+    layers["regions"] = png(render_regions(regions, &movable, pipeline_.scan_points()));
+    layers["elevation"] = png(render_elevation(pipeline_.map(), regions));
+    layers["movable"] = png(render_movable(pipeline_.map(), movable, regions));
+    areas = {regions.completed_m2(), regions.low_resolution_m2(), regions.unscanned_m2(),
+             movable.area_m2()};
+  }
+
   std::lock_guard lock(mutex_);
   scans_.push_back(record);
   map_ = std::move(next);
   encoded_ = std::move(encoded);
+  layers_ = std::move(layers);
+  areas_ = areas;
   return record;
 }
 
@@ -61,6 +88,17 @@ Bounds3 ScanStore::bounds() const {
 std::shared_ptr<const std::string> ScanStore::encoded_map() const {
   std::lock_guard lock(mutex_);
   return encoded_;
+}
+
+std::shared_ptr<const std::vector<std::uint8_t>> ScanStore::layer_png(const std::string& name) const {
+  std::lock_guard lock(mutex_);
+  const auto it = layers_.find(name);
+  return it == layers_.end() ? nullptr : it->second;
+}
+
+MapAreas ScanStore::areas() const {
+  std::lock_guard lock(mutex_);
+  return areas_;
 }
 
 void ScanStore::set_scan_state(const std::string& robot_id, RobotScanState state) {

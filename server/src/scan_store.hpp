@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "scanplan/core/mapping_pipeline.hpp"
 #include "scanplan/core/point_cloud.hpp"
 #include "scanplan/core/pose.hpp"
 
@@ -41,10 +42,18 @@ struct RobotState {
   RobotScanState scan;
 };
 
-// The scans of this session, in the map frame, plus the map's Draco encoding, rebuilt off the
-// network thread each time a scan lands so that serving the map never waits on the encoder.
+// Areas of the target region's C / M / U segmentation and of the movable region (m²).
+struct MapAreas {
+  double completed_m2 = 0, low_resolution_m2 = 0, unscanned_m2 = 0, movable_m2 = 0;
+};
+
+// The scans of this session, in the map frame, with what is derived from them: the map's Draco
+// encoding, the MLS map with its regions, and the top-view layers as PNG. All of it is rebuilt
+// off the network thread each time a scan lands, so serving never waits on an encoder.
 class ScanStore {
  public:
+  explicit ScanStore(PipelineConfig pipeline = {});
+
   // `cloud` is in the scanner's robot frame; `pose` places it in the map frame.
   ScanRecord add(const std::string& robot_id, const Pose& pose, std::int64_t stamp_ns,
                  const PointCloud& cloud);
@@ -55,6 +64,10 @@ class ScanStore {
   Bounds3 bounds() const;
   // Null while the map is empty.
   std::shared_ptr<const std::string> encoded_map() const;
+  // A top-view layer as PNG: "regions", "elevation" or "movable"; null before the first scan.
+  std::shared_ptr<const std::vector<std::uint8_t>> layer_png(const std::string& name) const;
+  static const std::vector<std::string>& layer_names();
+  MapAreas areas() const;
 
   void set_scan_state(const std::string& robot_id, RobotScanState state);
   void set_robot_status(const std::string& robot_id, RobotStatus status);
@@ -65,6 +78,9 @@ class ScanStore {
   std::vector<ScanRecord> scans_;
   PointCloud map_;
   std::shared_ptr<const std::string> encoded_;
+  std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> layers_;
+  MapAreas areas_;
+  MappingPipeline pipeline_;  // written only under encode_mutex_
   std::map<std::string, RobotState> robots_;
   std::mutex encode_mutex_;  // one encoder run at a time; readers keep the previous result
 };

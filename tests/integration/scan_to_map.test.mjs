@@ -105,3 +105,23 @@ test('a scan command brings a whole scan into the Draco map', async () => {
     assert.ok(Math.abs(max[a] - expectMax[a]) < 0.1, `max[${a}] = ${max[a]}`);
   }
 });
+
+test('top-view layers come from the MLS map', async () => {
+  for (const name of ['regions', 'elevation', 'movable']) {
+    const res = await stack.api('GET', `/api/v1/layers/${name}.png`);
+    assert.equal(res.status, 200, name);
+    assert.equal(res.headers.get('content-type'), 'image/png');
+    const bytes = new Uint8Array(await res.arrayBuffer());
+    assert.deepEqual([...bytes.subarray(1, 4)].map((c) => String.fromCharCode(c)).join(''), 'PNG');
+    // The default target region is 200 m square at 4 px a cell.
+    const width = new DataView(bytes.buffer).getUint32(16);
+    assert.ok(width >= 800 && width <= 808, `${name}.png is ${width} px wide`);
+  }
+  const unknown = await stack.api('GET', '/api/v1/layers/heat.png');
+  assert.equal(unknown.status, 404);
+  assert.match((await unknown.json()).error.message, /regions, elevation and movable/);
+  const { areas } = await (await stack.api('GET', '/api/v1/session')).json();
+  // From one scan in the 60 m × 40 m yard: up to 20 m around the scanner is scan-completed.
+  assert.ok(areas.completed_m2 > 600 && areas.completed_m2 <= Math.PI * 400, JSON.stringify(areas));
+  assert.ok(areas.movable_m2 > 800, JSON.stringify(areas));
+});

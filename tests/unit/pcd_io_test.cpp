@@ -1,19 +1,17 @@
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <charconv>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <initializer_list>
 #include <limits>
 #include <string>
 #include <string_view>
 
+#include "scan_file_test_support.hpp"
 #include "scanplan/core/pcd_io.hpp"
 #include "scanplan/core/ply_io.hpp"
 #include "scanplan/core/scan_file.hpp"
@@ -22,6 +20,10 @@ namespace scanplan {
 namespace {
 
 namespace fs = std::filesystem;
+using test_support::expect_error;
+using test_support::expect_same;
+using test_support::little_endian;
+using test_support::TempDir;
 
 PointCloud sample_cloud(bool colors, std::size_t n = 5) {
   PointCloud c;
@@ -36,35 +38,8 @@ PointCloud sample_cloud(bool colors, std::size_t n = 5) {
   return c;
 }
 
-void expect_same(const PointCloud& a, const PointCloud& b) {
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a.points[i], b.points[i]) << "point " << i;
-  EXPECT_EQ(a.colors, b.colors);
-}
-
-template <typename F>
-void expect_error(F&& read, std::initializer_list<std::string> fragments) {
-  try {
-    read();
-    ADD_FAILURE() << "expected a ScanFileError";
-  } catch (const ScanFileError& e) {
-    for (const auto& f : fragments) {
-      EXPECT_NE(std::string(e.what()).find(f), std::string::npos)
-          << "'" << f << "' not in: " << e.what();
-    }
-  }
-}
-
 void expect_bytes_error(const std::string& bytes, std::initializer_list<std::string> fragments) {
   expect_error([&] { read_pcd_bytes(bytes, "in.pcd"); }, fragments);
-}
-
-template <typename T>
-std::string le(T v) {
-  std::array<char, sizeof(T)> b;
-  std::memcpy(b.data(), &v, sizeof(T));
-  if constexpr (std::endian::native == std::endian::big) std::reverse(b.begin(), b.end());
-  return std::string(b.data(), b.size());
 }
 
 // A plain greedy LZF compressor, only to make test input for the reader's decompressor.
@@ -108,28 +83,9 @@ std::string lzf_compress(std::string_view in) {
 }
 
 std::string compressed_body(const std::string& raw, const std::string& lzf) {
-  return le(static_cast<std::uint32_t>(lzf.size())) + le(static_cast<std::uint32_t>(raw.size())) +
-         lzf;
+  return little_endian(static_cast<std::uint32_t>(lzf.size())) +
+         little_endian(static_cast<std::uint32_t>(raw.size())) + lzf;
 }
-
-class TempDir {
- public:
-  TempDir() {
-    const auto* t = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("scanplan_" + std::string(t->test_suite_name()) + "_" +
-                                         t->name() + "_" + std::to_string(::getpid()));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
 
 TEST(PcdIo, RoundTripsAsciiAndBinaryWithAndWithoutColour) {
   for (const bool binary : {false, true}) {
@@ -154,7 +110,7 @@ TEST(PcdIo, WritesRgbAsPclDoes) {
   EXPECT_NE(bin.find("FIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\nWIDTH 1\n"
                      "HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA binary\n"),
             std::string::npos);
-  EXPECT_EQ(bin.substr(bin.size() - 4), le(std::uint32_t{0x123456}));
+  EXPECT_EQ(bin.substr(bin.size() - 4), little_endian(std::uint32_t{0x123456}));
   const std::string ascii = write_pcd_bytes(c, false);
   EXPECT_EQ(ascii.substr(ascii.find("DATA ascii\n") + 11), "1 2 3 1193046\n");  // 0x123456
 }
@@ -200,9 +156,9 @@ TEST(PcdIo, ReadsDoublesAndSkipsOtherFieldsInBinary) {
       "COUNT 3 1 1 1 1 4\nWIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA binary\n";
   for (int i = 0; i < 2; ++i) {
     bytes += std::string(3, '\x7f');
-    bytes += le(1.0 + i) + le(-2.0 * i) + le(1e-3);
-    bytes += le(std::uint32_t{0xff102030} + static_cast<std::uint32_t>(i));
-    for (int k = 0; k < 4; ++k) bytes += le(static_cast<float>(k));
+    bytes += little_endian(1.0 + i) + little_endian(-2.0 * i) + little_endian(1e-3);
+    bytes += little_endian(std::uint32_t{0xff102030} + static_cast<std::uint32_t>(i));
+    for (int k = 0; k < 4; ++k) bytes += little_endian(static_cast<float>(k));
   }
   const PointCloud c = read_pcd_bytes(bytes, "d.pcd");
   ASSERT_EQ(c.size(), 2u);
@@ -214,7 +170,9 @@ TEST(PcdIo, DropsNaNPointsOfAnOrganizedCloud) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   std::string bytes =
       "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 2\nDATA binary\n";
-  for (const float x : {1.0f, nan, 3.0f, 4.0f}) bytes += le(x) + le(0.0f) + le(0.0f);
+  for (const float x : {1.0f, nan, 3.0f, 4.0f}) {
+    bytes += little_endian(x) + little_endian(0.0f) + little_endian(0.0f);
+  }
   PcdInfo info;
   const PointCloud c = read_pcd_bytes(bytes, "org.pcd", &info);
   ASSERT_EQ(c.size(), 3u);
@@ -236,13 +194,13 @@ TEST(PcdIo, ReadsBinaryCompressedColumnsWithoutPadding) {
   const std::size_t n = cloud.size();
   std::string raw;
   for (int a = 0; a < 3; ++a) {
-    for (std::size_t i = 0; i < n; ++i) raw += le(cloud.points[i][a]);
+    for (std::size_t i = 0; i < n; ++i) raw += little_endian(cloud.points[i][a]);
   }
   for (std::size_t i = 0; i < n; ++i) {
     const Rgb& c = cloud.colors[i];
-    raw += le((std::uint32_t{c[0]} << 16) | (std::uint32_t{c[1]} << 8) | c[2]);
+    raw += little_endian((std::uint32_t{c[0]} << 16) | (std::uint32_t{c[1]} << 8) | c[2]);
   }
-  for (std::size_t i = 0; i < n; ++i) raw += le(static_cast<float>(i % 7));  // intensity
+  for (std::size_t i = 0; i < n; ++i) raw += little_endian(static_cast<float>(i % 7));  // intensity
   const std::string lzf = lzf_compress(raw);
   ASSERT_LT(lzf.size(), raw.size());  // the stream really uses back references
   const std::string bytes =
@@ -261,12 +219,12 @@ TEST(PcdIo, DecodesAHandWrittenLzfBackReference) {
   // (length 20 - 2 = 18 = 7 + 11, so control 0xe0 and an extra length byte 11).
   // (Appended piecewise: g++ 12 warns falsely about "literal" + std::string here.)
   std::string lzf = "\x03";
-  lzf += le(1.0f);
+  lzf += little_endian(1.0f);
   lzf += "\xe0\x0b\x03";
   const std::string bytes =
       "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 2\n"
       "DATA binary_compressed\n" +
-      le(std::uint32_t{8}) + le(std::uint32_t{24}) + lzf;
+      little_endian(std::uint32_t{8}) + little_endian(std::uint32_t{24}) + lzf;
   const PointCloud c = read_pcd_bytes(bytes, "hand.pcd");
   ASSERT_EQ(c.size(), 2u);
   EXPECT_EQ(c.points[0], Eigen::Vector3f(1, 1, 1));
@@ -276,20 +234,24 @@ TEST(PcdIo, DecodesAHandWrittenLzfBackReference) {
 TEST(PcdIo, BadCompressedBlocksAreRejectedBeforeAllocating) {
   const std::string head =
       "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 100000000\nDATA binary_compressed\n";
-  expect_bytes_error(
-      head + le(std::uint32_t{10}) + le(std::uint32_t{1200000000}) + std::string(10, '\0'),
-      {"in.pcd", "10 bytes cannot unpack to the 1200000000 bytes"});
+  expect_bytes_error(head + little_endian(std::uint32_t{10}) +
+                         little_endian(std::uint32_t{1200000000}) + std::string(10, '\0'),
+                     {"in.pcd", "10 bytes cannot unpack to the 1200000000 bytes"});
   const std::string two = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 2\nDATA binary_compressed\n";
-  expect_bytes_error(two + le(std::uint32_t{8}) + le(std::uint32_t{20}) + std::string(8, '\0'),
+  expect_bytes_error(two + little_endian(std::uint32_t{8}) + little_endian(std::uint32_t{20}) +
+                         std::string(8, '\0'),
                      {"unpacks to 20 bytes"});
-  expect_bytes_error(two + le(std::uint32_t{800}) + le(std::uint32_t{24}) + std::string(8, '\0'),
+  expect_bytes_error(two + little_endian(std::uint32_t{800}) + little_endian(std::uint32_t{24}) +
+                         std::string(8, '\0'),
                      {"claims 800 bytes", "truncated"});
   expect_bytes_error(two + "\x08\x00", {"ends before the compressed block"});
   // A back reference before the start of the output.
-  expect_bytes_error(two + le(std::uint32_t{3}) + le(std::uint32_t{24}) + "\xe0\x0b\x03",
-                     {"corrupt"});
+  expect_bytes_error(
+      two + little_endian(std::uint32_t{3}) + little_endian(std::uint32_t{24}) + "\xe0\x0b\x03",
+      {"corrupt"});
   // A stream that stops short of the declared size.
-  expect_bytes_error(two + le(std::uint32_t{5}) + le(std::uint32_t{24}) + "\x03" + le(1.0f),
+  expect_bytes_error(two + little_endian(std::uint32_t{5}) + little_endian(std::uint32_t{24}) +
+                         "\x03" + little_endian(1.0f),
                      {"corrupt"});
 }
 
@@ -365,7 +327,7 @@ TEST(ScanFile, DispatchesOnExtension) {
   write_pcd(dir.path() / "b.PCD", cloud);
   expect_same(cloud, read_point_cloud(dir.path() / "a.ply"));
   expect_same(cloud, read_point_cloud(dir.path() / "b.PCD"));
-  { std::ofstream(dir.path() / "c.3d") << "100 0 0\n0 0 0\n"; }
+  dir.write("c.3d", "100 0 0\n0 0 0\n");
   const PointCloud t = read_point_cloud(dir.path() / "c.3d");
   ASSERT_EQ(t.size(), 1u);
   EXPECT_TRUE(t.points[0].isApprox(Eigen::Vector3f(0, -1, 0)));

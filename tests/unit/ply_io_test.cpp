@@ -1,22 +1,24 @@
 #include <gtest/gtest.h>
-#include <unistd.h>
 
-#include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
-#include <cstring>
 #include <filesystem>
 #include <initializer_list>
 #include <limits>
 #include <string>
 
+#include "scan_file_test_support.hpp"
 #include "scanplan/core/ply_io.hpp"
 
 namespace scanplan {
 namespace {
 
 namespace fs = std::filesystem;
+using test_support::big_endian;
+using test_support::expect_error;
+using test_support::expect_same;
+using test_support::little_endian;
+using test_support::TempDir;
 
 PointCloud sample_cloud(bool colors) {
   PointCloud c;
@@ -33,64 +35,9 @@ PointCloud sample_cloud(bool colors) {
   return c;
 }
 
-void expect_same(const PointCloud& a, const PointCloud& b) {
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a.points[i], b.points[i]) << "point " << i;
-  EXPECT_EQ(a.colors, b.colors);
-}
-
-// Runs `read` and checks that it throws a ScanFileError whose message holds every fragment.
-template <typename F>
-void expect_error(F&& read, std::initializer_list<std::string> fragments) {
-  try {
-    read();
-    ADD_FAILURE() << "expected a ScanFileError";
-  } catch (const ScanFileError& e) {
-    for (const auto& f : fragments) {
-      EXPECT_NE(std::string(e.what()).find(f), std::string::npos)
-          << "'" << f << "' not in: " << e.what();
-    }
-  }
-}
-
 void expect_bytes_error(const std::string& bytes, std::initializer_list<std::string> fragments) {
   expect_error([&] { read_ply_bytes(bytes, "in.ply"); }, fragments);
 }
-
-template <typename T>
-std::string big_endian(T v) {
-  std::array<char, sizeof(T)> b;
-  std::memcpy(b.data(), &v, sizeof(T));
-  if constexpr (std::endian::native == std::endian::little) std::reverse(b.begin(), b.end());
-  return std::string(b.data(), b.size());
-}
-
-template <typename T>
-std::string little_endian(T v) {
-  std::array<char, sizeof(T)> b;
-  std::memcpy(b.data(), &v, sizeof(T));
-  if constexpr (std::endian::native == std::endian::big) std::reverse(b.begin(), b.end());
-  return std::string(b.data(), b.size());
-}
-
-class TempDir {
- public:
-  TempDir() {
-    const auto* t = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("scanplan_" + std::string(t->test_suite_name()) + "_" +
-                                         t->name() + "_" + std::to_string(::getpid()));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
 
 TEST(PlyIo, RoundTripsInEveryFormatWithAndWithoutColour) {
   for (const PlyFormat format :

@@ -1,12 +1,11 @@
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <initializer_list>
 #include <string>
 
+#include "scan_file_test_support.hpp"
 #include "scanplan/core/pcd_io.hpp"
 #include "scanplan/core/ply_io.hpp"
 #include "scanplan/core/replay_folder.hpp"
@@ -15,28 +14,8 @@ namespace scanplan {
 namespace {
 
 namespace fs = std::filesystem;
-
-class TempDir {
- public:
-  TempDir() {
-    const auto* t = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("scanplan_" + std::string(t->test_suite_name()) + "_" +
-                                         t->name() + "_" + std::to_string(::getpid()));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-  void write(const std::string& name, const std::string& text) const {
-    std::ofstream(path_ / name, std::ios::binary) << text;
-  }
-
- private:
-  fs::path path_;
-};
+using test_support::expect_error;
+using test_support::TempDir;
 
 PointCloud cloud_of(float x, std::size_t n) {
   PointCloud c;
@@ -47,24 +26,17 @@ PointCloud cloud_of(float x, std::size_t n) {
   return c;
 }
 
-template <typename Error>
-void expect_error(const fs::path& dir, std::initializer_list<std::string> fragments) {
-  try {
-    ReplayFolder folder(dir);
-    ADD_FAILURE() << "expected an error for " << dir;
-  } catch (const Error& e) {
-    for (const auto& f : fragments) {
-      EXPECT_NE(std::string(e.what()).find(f), std::string::npos)
-          << "'" << f << "' not in: " << e.what();
-    }
-  }
+// Checks that opening `dir` as a replay folder throws a ReplayFolderError saying `fragments`.
+void expect_folder_error(const fs::path& dir, std::initializer_list<std::string> fragments) {
+  SCOPED_TRACE(dir.string());
+  expect_error<ReplayFolderError>([&] { const ReplayFolder folder(dir); }, fragments);
 }
 
 void expect_csv_error(const std::string& csv, std::initializer_list<std::string> fragments) {
   TempDir dir;
   write_ply(dir.path() / "a.ply", cloud_of(0, 1));
   dir.write("poses.csv", csv);
-  expect_error<ReplayFolderError>(dir.path(), fragments);
+  expect_folder_error(dir.path(), fragments);
 }
 
 TEST(ReplayFolder, ListsCsvScansInOrderWithPosesAndImages) {
@@ -147,21 +119,16 @@ TEST(ReplayFolder, ABrokenScanFailsOnlyWhenLoaded) {
   dir.write("poses.csv", "file,x,y,z,yaw_deg\nbad.ply,0,0,0,0\ngood.ply,1,0,0,0\n");
   const ReplayFolder folder(dir.path());
   ASSERT_EQ(folder.size(), 2u);
-  try {
-    folder.load(0);
-    ADD_FAILURE() << "expected a ScanFileError";
-  } catch (const ScanFileError& e) {
-    EXPECT_NE(std::string(e.what()).find("bad.ply"), std::string::npos) << e.what();
-  }
+  expect_error([&] { folder.load(0); }, {"bad.ply"});
   EXPECT_EQ(folder.load(1).size(), 2u);  // playback goes on with the next scan
 }
 
 TEST(ReplayFolder, FolderErrors) {
   TempDir dir;
-  expect_error<ReplayFolderError>(dir.path() / "nope", {"nope", "no such directory"});
+  expect_folder_error(dir.path() / "nope", {"nope", "no such directory"});
   dir.write("file.txt", "x");
-  expect_error<ReplayFolderError>(dir.path() / "file.txt", {"not a directory"});
-  expect_error<ReplayFolderError>(dir.path(), {"neither poses.csv nor 3DTK scanNNN.3d"});
+  expect_folder_error(dir.path() / "file.txt", {"not a directory"});
+  expect_folder_error(dir.path(), {"neither poses.csv nor 3DTK scanNNN.3d"});
 }
 
 TEST(ReplayFolder, ListsThreedtkScansByNumber) {
@@ -193,13 +160,13 @@ TEST(ReplayFolder, ThreedtkErrors) {
   {
     TempDir dir;
     dir.write("scan000.3d", "1 2 3\n");
-    expect_error<ReplayFolderError>(dir.path(), {"scan000.pose", "missing"});
+    expect_folder_error(dir.path(), {"scan000.pose", "missing"});
   }
   {
     TempDir dir;
     dir.write("scan000.3d", "1 2 3\n");
     dir.write("scan000.pose", "1 2 3\n4 5\n");
-    expect_error<ReplayFolderError>(dir.path(), {"scan000.pose", "expected 6 numbers"});
+    expect_folder_error(dir.path(), {"scan000.pose", "expected 6 numbers"});
   }
   {
     TempDir dir;
@@ -207,12 +174,12 @@ TEST(ReplayFolder, ThreedtkErrors) {
       dir.write(std::string(stem) + ".3d", "1 2 3\n");
       dir.write(std::string(stem) + ".pose", "0 0 0 0 0 0\n");
     }
-    expect_error<ReplayFolderError>(dir.path(), {"the same scan number"});
+    expect_folder_error(dir.path(), {"the same scan number"});
   }
 }
 
 TEST(ReplayFolder, PlaysTheThreedtkSampleFolder) {
-  const fs::path data = fs::path(SCANPLAN_SOURCE_DIR) / ".." / "shared" / "data" / "3dtk-scans";
+  const fs::path data = test_support::threedtk_sample_dir();
   if (!fs::exists(data / "scan000.3d")) {
     GTEST_SKIP() << "3DTK sample scans not found at " << data;
   }

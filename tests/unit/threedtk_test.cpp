@@ -4,12 +4,12 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
-#include <initializer_list>
 #include <map>
 #include <random>
 #include <sstream>
 #include <string>
 
+#include "scan_file_test_support.hpp"
 #include "scanplan/core/pose.hpp"
 #include "scanplan/core/threedtk.hpp"
 
@@ -17,21 +17,9 @@ namespace scanplan {
 namespace {
 
 namespace fs = std::filesystem;
+using test_support::expect_error;
 
-const fs::path kData = fs::path(SCANPLAN_SOURCE_DIR) / ".." / "shared" / "data" / "3dtk-scans";
-
-template <typename F>
-void expect_error(F&& read, std::initializer_list<std::string> fragments) {
-  try {
-    read();
-    ADD_FAILURE() << "expected a ScanFileError";
-  } catch (const ScanFileError& e) {
-    for (const auto& f : fragments) {
-      EXPECT_NE(std::string(e.what()).find(f), std::string::npos)
-          << "'" << f << "' not in: " << e.what();
-    }
-  }
-}
+const fs::path kData = test_support::threedtk_sample_dir();
 
 #define SKIP_WITHOUT_DATA()                                                          \
   if (!fs::exists(kData / "scan000.3d")) {                                           \
