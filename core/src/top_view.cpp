@@ -33,13 +33,6 @@ cv::Mat paint(const RegionMap& regions, const TopViewStyle& style, Fn&& fn) {
   return img;
 }
 
-cv::Point pixel_of(const RegionMap& regions, const Eigen::Vector2d& p, int s) {
-  const auto& g = regions.cells;
-  const double x = (p.x() / g.cell_m - g.origin.x) * s;
-  const double y = (g.rows - (p.y() / g.cell_m - g.origin.y)) * s;
-  return {static_cast<int>(std::lround(x)), static_cast<int>(std::lround(y))};
-}
-
 }  // namespace
 
 cv::Mat render_regions(const RegionMap& regions, const MovableRegion* movable,
@@ -63,7 +56,7 @@ cv::Mat render_regions(const RegionMap& regions, const MovableRegion* movable,
     const bool first = k == 0, last = k + 1 == scan_points.size() && k > 0;
     const cv::Scalar color = first ? cv::Scalar(220, 60, 20) : last ? cv::Scalar(30, 30, 220)
                                                                     : cv::Scalar(40, 40, 40);
-    const cv::Point p = pixel_of(regions, scan_points[k], s);
+    const cv::Point p = top_view_pixel(regions, scan_points[k], style);
     cv::circle(img, p, radius, color, -1, cv::LINE_AA);
     cv::circle(img, p, radius, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   }
@@ -101,6 +94,15 @@ cv::Mat render_movable(const MlsMap& map, const MovableRegion& movable, const Re
     if (movable.contains(c)) return kMovable;
     return map.cell(c) ? kData : kUnscanned;
   });
+}
+
+cv::Point top_view_pixel(const RegionMap& regions, const Eigen::Vector2d& p,
+                         const TopViewStyle& style) {
+  const auto& g = regions.cells;
+  const int s = std::max(1, style.px_per_cell);
+  const double x = (p.x() / g.cell_m - g.origin.x) * s;
+  const double y = (g.rows - (p.y() / g.cell_m - g.origin.y)) * s;
+  return {static_cast<int>(std::lround(x)), static_cast<int>(std::lround(y))};
 }
 
 std::vector<std::uint8_t> encode_png(const cv::Mat& bgr) {

@@ -34,4 +34,8 @@ cv::Mat render_movable(const MlsMap& map, const MovableRegion& movable, const Re
 
 std::vector<std::uint8_t> encode_png(const cv::Mat& bgr);
 
+// The pixel of a map position in a top view of `regions`.
+cv::Point top_view_pixel(const RegionMap& regions, const Eigen::Vector2d& p,
+                         const TopViewStyle& style = {});
+
 }  // namespace scanplan

@@ -1,0 +1,66 @@
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "scanplan/core/point_cloud.hpp"
+#include "scanplan/core/pose.hpp"
+
+struct sqlite3;
+
+namespace scanplan {
+
+class SessionStoreError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct StoredScan {
+  std::int64_t id = 0;
+  std::string robot;
+  Pose estimated;  // the pose the robot reported
+  Pose placed;     // where the map put the scan (after matching)
+  std::int64_t stamp_ns = 0;
+  std::size_t points = 0;
+  std::string file;  // the scan's PLY, relative to the session directory
+  std::string received_at;  // UTC, ISO 8601
+};
+
+// A session on disk (DESIGN.md "Session directory"): session.sqlite in WAL mode plus one binary
+// PLY per scan under scans/. A scan is acknowledged only once both are durable: the PLY is
+// written to a temporary name, synced and renamed before its row commits, so a process killed
+// at any moment leaves either the whole scan or none of it (an orphaned PLY without its row is
+// ignored and removed on the next open).
+class SessionStore {
+ public:
+  // Opens or creates the session in `dir`; throws SessionStoreError naming the path.
+  explicit SessionStore(std::filesystem::path dir);
+  ~SessionStore();
+  SessionStore(const SessionStore&) = delete;
+  SessionStore& operator=(const SessionStore&) = delete;
+
+  const std::filesystem::path& dir() const { return dir_; }
+
+  // `cloud` in the scan's own frame. Returns the new scan with its id.
+  StoredScan add_scan(const std::string& robot, const Pose& estimated, const Pose& placed,
+                      std::int64_t stamp_ns, const PointCloud& cloud);
+  std::vector<StoredScan> scans() const;
+  std::optional<StoredScan> scan(std::int64_t id) const;
+  PointCloud load_points(const StoredScan& scan) const;
+
+  // A key-value record of what happened (decisions, events), in order, as JSON text.
+  std::int64_t append_event(const std::string& kind, const std::string& json);
+
+ private:
+  void exec(const char* sql) const;
+  void remove_orphans() const;
+
+  std::filesystem::path dir_;
+  sqlite3* db_ = nullptr;
+};
+
+}  // namespace scanplan
