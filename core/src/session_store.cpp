@@ -159,6 +159,7 @@ void SessionStore::remove_orphans() const {
 StoredScan SessionStore::add_scan(const std::string& robot, const Pose& estimated,
                                   const Pose& placed, std::int64_t stamp_ns,
                                   const PointCloud& cloud) {
+  std::lock_guard lock(mutex_);
   exec("BEGIN IMMEDIATE");
   try {
     StoredScan r;
@@ -196,6 +197,7 @@ StoredScan SessionStore::add_scan(const std::string& robot, const Pose& estimate
 }
 
 std::vector<StoredScan> SessionStore::scans() const {
+  std::lock_guard lock(mutex_);
   std::vector<StoredScan> out;
   Statement s(db_, (std::string("SELECT ") + kScanColumns + " FROM scans ORDER BY id").c_str());
   while (s.step()) out.push_back(scan_from_row(s));
@@ -203,6 +205,7 @@ std::vector<StoredScan> SessionStore::scans() const {
 }
 
 std::optional<StoredScan> SessionStore::scan(std::int64_t id) const {
+  std::lock_guard lock(mutex_);
   Statement s(db_, (std::string("SELECT ") + kScanColumns + " FROM scans WHERE id = ?").c_str());
   s.bind(1, id);
   if (!s.step()) return std::nullopt;
@@ -214,6 +217,7 @@ PointCloud SessionStore::load_points(const StoredScan& scan) const {
 }
 
 std::int64_t SessionStore::append_event(const std::string& kind, const std::string& json) {
+  std::lock_guard lock(mutex_);
   Statement s(db_, "INSERT INTO events(at, kind, json) VALUES(?, ?, ?)");
   s.bind(1, utc_now()).bind(2, kind).bind(3, json);
   s.step();

@@ -1,9 +1,12 @@
 #include "api.hpp"
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "http/http_error.hpp"
+#include "scanplan/core/scan_file.hpp"
 
 namespace scanplan::server {
 
@@ -22,6 +25,35 @@ json pose_json(const Pose& p) {
   return {{"x", p.x}, {"y", p.y}, {"z", p.z}, {"yaw_deg", rad2deg(p.yaw)}};
 }
 
+json scan_json(const StoredScan& s) {
+  return {{"id", s.id},
+          {"robot", s.robot},
+          {"points", s.points},
+          {"estimated", pose_json(s.estimated)},
+          {"placed", pose_json(s.placed)},
+          {"received_at", s.received_at}};
+}
+
+// A required, finite number from the query string.
+double query_number(const Request& r, const std::string& name) {
+  const auto it = r.query.find(name);
+  if (it == r.query.end()) {
+    throw HttpError(400, "bad_request", "query parameter '" + name + "' is required");
+  }
+  std::size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(it->second, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != it->second.size() || !std::isfinite(v)) {
+    throw HttpError(400, "bad_request",
+                    "query parameter '" + name + "' must be a finite number, got '" + it->second + "'");
+  }
+  return v;
+}
+
 std::string iso_time(std::chrono::system_clock::time_point t) {
   const std::time_t tt = std::chrono::system_clock::to_time_t(t);
   std::tm tm{};
@@ -33,8 +65,10 @@ std::string iso_time(std::chrono::system_clock::time_point t) {
 
 }  // namespace
 
-Api::Api(ScanStore& store, DdsLink& dds, const Auth& auth, std::string session_dir)
+Api::Api(ScanStore& store, ScanIntake& intake, DdsLink& dds, const Auth& auth,
+         std::string session_dir)
     : store_(store),
+      intake_(intake),
       dds_(dds),
       auth_(auth),
       session_dir_(std::move(session_dir)),
@@ -53,6 +87,18 @@ void Api::install(http::Router& router) {
   router.add("GET", "/api/v1/layers/{layer}.png", [this](const Request& r, const auto& params) {
     require(r, Role::kViewer);
     return layer(params.at("layer"));
+  });
+  router.add("GET", "/api/v1/scans", [this](const Request& r, const auto&) {
+    require(r, Role::kViewer);
+    return list_scans();
+  });
+  router.add("GET", "/api/v1/scans/{id}", [this](const Request& r, const auto& params) {
+    require(r, Role::kViewer);
+    return get_scan(params.at("id"));
+  });
+  router.add("POST", "/api/v1/scans", [this](const Request& r, const auto&) {
+    require(r, Role::kOperator);
+    return post_scan(r);
   });
   router.add("POST", "/api/v1/scan", [this](const Request& r, const auto&) {
     require(r, Role::kOperator);
@@ -104,9 +150,9 @@ Response Api::session() const {
     const Bounds3 b = store_.bounds();
     j["bounds"] = {{"min", vec3(b.min)}, {"max", vec3(b.max)}};
     j["last_scan"] = {{"id", scans.back().id},
-                      {"robot", scans.back().robot_id},
+                      {"robot", scans.back().robot},
                       {"points", scans.back().points},
-                      {"pose", pose_json(scans.back().pose)}};
+                      {"pose", pose_json(scans.back().placed)}};
   }
   return Response::json(200, j);
 }
@@ -138,6 +184,56 @@ Response Api::layer(const std::string& name) const {
   Response r = Response::bytes(std::string(png->begin(), png->end()), "image/png");
   r.set_header("Cache-Control", "no-store");
   return r;
+}
+
+Response Api::post_scan(const Request& request) {
+  Pose estimated;
+  estimated.x = query_number(request, "x");
+  estimated.y = query_number(request, "y");
+  estimated.z = query_number(request, "z");
+  estimated.yaw = deg2rad(query_number(request, "yaw_deg"));
+  std::string robot = "robot1";
+  if (const auto it = request.query.find("robot"); it != request.query.end()) robot = it->second;
+  if (robot.empty() || robot.size() > 64 || robot.find('/') != std::string::npos) {
+    throw HttpError(400, "bad_request", "'robot' must be 1 to 64 characters without '/'");
+  }
+  if (request.body.empty()) {
+    throw HttpError(400, "bad_request", "the body must be the scan as a PLY or PCD file");
+  }
+  PointCloud cloud;
+  try {
+    cloud = read_point_cloud_bytes(request.body, "the uploaded scan");
+  } catch (const ScanFileError& e) {
+    throw HttpError(400, "bad_scan", e.what());
+  }
+  if (cloud.empty()) throw HttpError(400, "bad_scan", "the uploaded scan holds no valid points");
+  const auto stamp = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                         std::chrono::system_clock::now().time_since_epoch())
+                         .count();
+  try {
+    const StoredScan s = intake_.submit(robot, estimated, stamp, std::move(cloud));
+    return Response::json(201, scan_json(s));
+  } catch (const SessionStoreError& e) {
+    throw HttpError(503, "storage_failed", std::string("the scan could not be stored: ") + e.what());
+  }
+}
+
+Response Api::list_scans() const {
+  json list = json::array();
+  for (const StoredScan& s : store_.scans()) list.push_back(scan_json(s));
+  return Response::json(200, {{"scans", list}, {"pending", intake_.pending()}});
+}
+
+Response Api::get_scan(const std::string& id) const {
+  std::int64_t n = 0;
+  const auto [end, ec] = std::from_chars(id.data(), id.data() + id.size(), n);
+  if (ec != std::errc() || end != id.data() + id.size() || n <= 0) {
+    throw HttpError(400, "bad_request", "a scan id is a positive whole number, got '" + id + "'");
+  }
+  for (const StoredScan& s : store_.scans()) {
+    if (s.id == n) return Response::json(200, scan_json(s));
+  }
+  throw HttpError(404, "not_found", "no scan " + id + " in this session");
 }
 
 Response Api::request_scan(const Request& request) {

@@ -14,7 +14,8 @@ namespace scanplan::server {
 // link and back; they hold no state of their own beyond the session's start time.
 class Api {
  public:
-  Api(ScanStore& store, DdsLink& dds, const Auth& auth, std::string session_dir);
+  Api(ScanStore& store, ScanIntake& intake, DdsLink& dds, const Auth& auth,
+      std::string session_dir);
   void install(http::Router& router);
 
  private:
@@ -26,8 +27,12 @@ class Api {
   http::Response map_drc(const http::Request& request) const;
   http::Response layer(const std::string& name) const;
   http::Response request_scan(const http::Request& request);
+  http::Response post_scan(const http::Request& request);
+  http::Response list_scans() const;
+  http::Response get_scan(const std::string& id) const;
 
   ScanStore& store_;
+  ScanIntake& intake_;
   DdsLink& dds_;
   const Auth& auth_;
   std::string session_dir_;

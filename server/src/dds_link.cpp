@@ -26,8 +26,8 @@ std::string str(const char* s) {
 
 }  // namespace
 
-DdsLink::DdsLink(std::uint32_t domain_id, ScanStore& store)
-    : store_(store), participant_(domain_id) {
+DdsLink::DdsLink(std::uint32_t domain_id, ScanStore& store, ScanIntake& intake)
+    : store_(store), intake_(intake), participant_(domain_id) {
   using dds::QosKind;
   auto& p = participant_;
   points_reader_ =
@@ -167,9 +167,8 @@ void DdsLink::store_scan(const Key& key, PartialScan& s) {
     spdlog::warn("scan from '{}' came without a panorama: stored uncoloured", robot);
   }
   try {
-    const ScanRecord r = store_.add(robot, *s.pose, key.second, cloud);
-    spdlog::info("scan {} from '{}': {} points at ({:.2f}, {:.2f}, {:.2f})", r.id, robot, r.points,
-                 r.pose.x, r.pose.y, r.pose.z);
+    const StoredScan r = intake_.submit(robot, *s.pose, key.second, std::move(cloud));
+    spdlog::info("scan {} from '{}' stored: {} points", r.id, robot, r.points);
   } catch (const std::exception& e) {
     spdlog::error("could not store a scan from '{}': {}", robot, e.what());
   }

@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "scan_intake.hpp"
 #include "scan_store.hpp"
 #include "scanplan/core/panorama_camera.hpp"
 #include "scanplan/core/point_cloud.hpp"
@@ -28,7 +29,7 @@ class NoScannerError : public std::runtime_error {
 // commands on behalf of the API.
 class DdsLink {
  public:
-  DdsLink(std::uint32_t domain_id, ScanStore& store);
+  DdsLink(std::uint32_t domain_id, ScanStore& store, ScanIntake& intake);
   ~DdsLink();
   DdsLink(const DdsLink&) = delete;
   DdsLink& operator=(const DdsLink&) = delete;
@@ -61,6 +62,7 @@ class DdsLink {
   void store_scan(const Key& key, PartialScan& scan);
 
   ScanStore& store_;
+  ScanIntake& intake_;
   dds::Participant participant_;
   dds_entity_t points_reader_, pose_reader_, image_reader_, camera_info_reader_, progress_reader_,
       status_reader_, scan_cmd_writer_;

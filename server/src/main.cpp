@@ -56,16 +56,17 @@ int main(int argc, char** argv) {
     const int port = std::stoi(listen.substr(colon + 1));
     if (port < 0 || port > 65535) throw std::runtime_error("--listen port must be 0..65535");
     config.port = static_cast<std::uint16_t>(port);
-    std::filesystem::create_directories(session_dir);
 
     std::string operator_token = env_or_empty("SCANPLAN_OPERATOR_TOKEN");
     const bool generated = operator_token.empty();
     if (generated) operator_token = srv::Auth::random_token();
     const srv::Auth auth(operator_token, env_or_empty("SCANPLAN_VIEWER_TOKEN"));
 
+    scanplan::SessionStore session(session_dir);
     srv::ScanStore store;
-    srv::DdsLink dds(domain, store);
-    srv::Api api(store, dds, auth, session_dir);
+    srv::ScanIntake intake(session, store);
+    srv::DdsLink dds(domain, store, intake);
+    srv::Api api(store, intake, dds, auth, session_dir);
     http::Router router([](std::string_view msg) { spdlog::error("{}", msg); });
     api.install(router);
     const http::StaticFiles files(web_dir);
@@ -74,6 +75,7 @@ int main(int argc, char** argv) {
 
     http::HttpServer server(config, [&router](const http::Request& r) { return router.route(r); });
     server.start();
+    intake.start();
     dds.start();
     g_server = &server;
     std::signal(SIGINT, on_signal);
@@ -87,6 +89,7 @@ int main(int argc, char** argv) {
     server.run();
     g_server = nullptr;
     dds.stop();
+    intake.stop();
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 1;

@@ -12,8 +12,8 @@ const std::vector<std::string>& ScanStore::layer_names() {
   return kNames;
 }
 
-ScanRecord ScanStore::add(const std::string& robot_id, const Pose& pose, std::int64_t stamp_ns,
-                          const PointCloud& cloud) {
+void ScanStore::add(const StoredScan& scan, const PointCloud& cloud) {
+  const Pose& pose = scan.placed;
   const Eigen::Affine3f map_from_robot = pose.isometry().cast<float>();
   PointCloud placed;
   placed.reserve(cloud.size());
@@ -26,17 +26,11 @@ ScanRecord ScanStore::add(const std::string& robot_id, const Pose& pose, std::in
   // they see the scan, its points and the map encoding that includes it appear together.
   std::lock_guard encode_lock(encode_mutex_);
   PointCloud next;
-  ScanRecord record;
   {
     std::lock_guard lock(mutex_);
     next = map_;
-    record.id = scans_.size() + 1;
   }
   next.append(placed);
-  record.robot_id = robot_id;
-  record.pose = pose;
-  record.stamp_ns = stamp_ns;
-  record.points = placed.size();
   std::shared_ptr<const std::string> encoded;
   if (!next.empty()) encoded = std::make_shared<const std::string>(encode_draco(next));
 
@@ -57,15 +51,14 @@ ScanRecord ScanStore::add(const std::string& robot_id, const Pose& pose, std::in
   }
 
   std::lock_guard lock(mutex_);
-  scans_.push_back(record);
+  scans_.push_back(scan);
   map_ = std::move(next);
   encoded_ = std::move(encoded);
   layers_ = std::move(layers);
   areas_ = areas;
-  return record;
 }
 
-std::vector<ScanRecord> ScanStore::scans() const {
+std::vector<StoredScan> ScanStore::scans() const {
   std::lock_guard lock(mutex_);
   return scans_;
 }

@@ -10,16 +10,9 @@
 #include "scanplan/core/mapping_pipeline.hpp"
 #include "scanplan/core/point_cloud.hpp"
 #include "scanplan/core/pose.hpp"
+#include "scanplan/core/session_store.hpp"
 
 namespace scanplan::server {
-
-struct ScanRecord {
-  std::uint64_t id = 0;
-  std::string robot_id;
-  Pose pose;  // where the scan was placed in the map frame
-  std::int64_t stamp_ns = 0;
-  std::size_t points = 0;
-};
 
 // What the session knows of one robot's current scan.
 struct RobotScanState {
@@ -54,11 +47,11 @@ class ScanStore {
  public:
   explicit ScanStore(PipelineConfig pipeline = {});
 
-  // `cloud` is in the scanner's robot frame; `pose` places it in the map frame.
-  ScanRecord add(const std::string& robot_id, const Pose& pose, std::int64_t stamp_ns,
-                 const PointCloud& cloud);
+  // A stored scan joins the map: `cloud` is in the scan's own frame, `scan.placed` puts it in
+  // the map frame. Scans must come in id order.
+  void add(const StoredScan& scan, const PointCloud& cloud);
 
-  std::vector<ScanRecord> scans() const;
+  std::vector<StoredScan> scans() const;
   std::size_t scan_count() const;
   std::size_t point_count() const;
   Bounds3 bounds() const;
@@ -75,7 +68,7 @@ class ScanStore {
 
  private:
   mutable std::mutex mutex_;
-  std::vector<ScanRecord> scans_;
+  std::vector<StoredScan> scans_;
   PointCloud map_;
   std::shared_ptr<const std::string> encoded_;
   std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> layers_;

@@ -60,11 +60,11 @@ async function waitFor(what, fn, timeoutMs, procs = []) {
   }
 }
 
-export async function startStack({ world, replay, timeScale = 600, seed = 1 } = {}) {
-  const dir = mkdtempSync(join(tmpdir(), 'scanplan-test-'));
+export async function startStack({ world, replay, timeScale = 600, seed = 1, bridge: withBridge = true,
+                                   dir = mkdtempSync(join(tmpdir(), 'scanplan-test-')), tokens } = {}) {
   const domain = requireEnv('SCANPLAN_TEST_DOMAIN');
-  const token = randomBytes(16).toString('hex');
-  const viewerToken = randomBytes(16).toString('hex');
+  const token = tokens?.operator ?? randomBytes(16).toString('hex');
+  const viewerToken = tokens?.viewer ?? randomBytes(16).toString('hex');
   const worldFile = world ?? join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples/worlds/yard.json');
 
   const server = startProcess(
@@ -72,12 +72,12 @@ export async function startStack({ world, replay, timeScale = 600, seed = 1 } = 
     ['--session', join(dir, 'session'), '--listen', '127.0.0.1:0', '--domain', domain,
      '--web', requireEnv('SCANPLAN_WEB_DIR')],
     { SCANPLAN_OPERATOR_TOKEN: token, SCANPLAN_VIEWER_TOKEN: viewerToken }, 'scanplan-server');
-  const bridge = startProcess(
+  const bridge = withBridge && startProcess(
     requireEnv('SCANPLAN_BRIDGE'),
     [...(replay ? ['--replay', replay] : ['--world', worldFile]),
      '--domain', domain, '--time-scale', String(timeScale), '--seed', String(seed)],
     {}, 'scanplan-bridge');
-  const procs = [server, bridge];
+  const procs = withBridge ? [server, bridge] : [server];
 
   const url = await waitFor('the server to listen',
     async () => server.log.match(/listening on (http:\/\/[0-9.:]+)\//)?.[1], 15000, procs);
@@ -90,17 +90,19 @@ export async function startStack({ world, replay, timeScale = 600, seed = 1 } = 
   const stack = {
     url, token, viewerToken, dir, server, bridge, api,
     waitFor: (what, fn, timeoutMs = 60000) => waitFor(what, fn, timeoutMs, procs),
-    async stop() {
-      for (const p of procs) if (p.exitCode === null) p.kill('SIGTERM');
+    async stop({ keepDir = false, signal = 'SIGTERM' } = {}) {
+      for (const p of procs) if (p.exitCode === null && p.signalCode === null) p.kill(signal);
       const results = await Promise.all(procs.map((p) => p.exited));
-      rmSync(dir, { recursive: true, force: true });
+      if (!keepDir) rmSync(dir, { recursive: true, force: true });
       return results;
     },
   };
-  await stack.waitFor('the bridge to be matched on DDS', async () => {
-    const h = await (await api('GET', '/api/v1/health', { auth: null })).json();
-    return h.bridges >= 1;
-  }, 20000);
+  if (withBridge) {
+    await stack.waitFor('the bridge to be matched on DDS', async () => {
+      const h = await (await api('GET', '/api/v1/health', { auth: null })).json();
+      return h.bridges >= 1;
+    }, 20000);
+  }
   return stack;
 }
 

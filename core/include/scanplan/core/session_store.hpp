@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -34,7 +35,7 @@ struct StoredScan {
 // PLY per scan under scans/. A scan is acknowledged only once both are durable: the PLY is
 // written to a temporary name, synced and renamed before its row commits, so a process killed
 // at any moment leaves either the whole scan or none of it (an orphaned PLY without its row is
-// ignored and removed on the next open).
+// ignored and removed on the next open). Safe to use from several threads.
 class SessionStore {
  public:
   // Opens or creates the session in `dir`; throws SessionStoreError naming the path.
@@ -61,6 +62,8 @@ class SessionStore {
 
   std::filesystem::path dir_;
   sqlite3* db_ = nullptr;
+  // One connection, so one writer at a time: a transaction spans several calls.
+  mutable std::mutex mutex_;
 };
 
 }  // namespace scanplan

@@ -1,0 +1,84 @@
+#include "scan_intake.hpp"
+
+#include <spdlog/spdlog.h>
+
+namespace scanplan::server {
+
+ScanIntake::ScanIntake(SessionStore& session, ScanStore& live) : session_(session), live_(live) {}
+
+ScanIntake::~ScanIntake() { stop(); }
+
+void ScanIntake::start() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = false;
+  }
+  // Taken before anything can submit, so no scan is both on this list and in the queue.
+  std::vector<StoredScan> existing = session_.scans();
+  worker_ = std::thread([this, existing = std::move(existing)] {
+    // A restarted server rebuilds its map from the session on disk, scan by scan, while it
+    // already answers requests.
+    for (const StoredScan& s : existing) {
+      {
+        std::lock_guard lock(mutex_);
+        if (stop_) return;
+      }
+      try {
+        live_.add(s, session_.load_points(s));
+      } catch (const std::exception& e) {
+        spdlog::error("scan {} of the session cannot be read back: {}", s.id, e.what());
+      }
+    }
+    loop();
+  });
+}
+
+void ScanIntake::stop() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+StoredScan ScanIntake::submit(const std::string& robot, const Pose& estimated,
+                              std::int64_t stamp_ns, PointCloud cloud) {
+  // Matching will correct `placed`; until then the reported pose is the best there is.
+  StoredScan stored = session_.add_scan(robot, estimated, estimated, stamp_ns, cloud);
+  {
+    std::lock_guard lock(mutex_);
+    queue_.emplace_back(stored, std::move(cloud));
+  }
+  wake_.notify_one();
+  return stored;
+}
+
+std::size_t ScanIntake::pending() const {
+  std::lock_guard lock(mutex_);
+  return queue_.size();
+}
+
+void ScanIntake::loop() {
+  for (;;) {
+    std::pair<StoredScan, PointCloud> next;
+    {
+      std::unique_lock lock(mutex_);
+      wake_.wait(lock, [&] { return stop_ || !queue_.empty(); });
+      if (stop_) return;
+      next = std::move(queue_.front());
+    }
+    try {
+      live_.add(next.first, next.second);
+      spdlog::info("scan {} from '{}' is in the map: {} points at ({:.2f}, {:.2f}, {:.2f})",
+                   next.first.id, next.first.robot, next.first.points, next.first.placed.x,
+                   next.first.placed.y, next.first.placed.z);
+    } catch (const std::exception& e) {
+      spdlog::error("scan {} could not join the map: {}", next.first.id, e.what());
+    }
+    std::lock_guard lock(mutex_);
+    queue_.pop_front();
+  }
+}
+
+}  // namespace scanplan::server

@@ -1,0 +1,48 @@
+#pragma once
+
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <utility>
+
+#include "scan_store.hpp"
+#include "scanplan/core/session_store.hpp"
+
+namespace scanplan::server {
+
+// Where scans enter the session, from DDS or from POST /api/v1/scans. Each is first stored
+// durably (that is what acknowledges it), then processed into the live map on a worker thread,
+// so neither the network thread nor the DDS thread waits on the map, the layers or Draco.
+class ScanIntake {
+ public:
+  ScanIntake(SessionStore& session, ScanStore& live);
+  ~ScanIntake();
+  ScanIntake(const ScanIntake&) = delete;
+  ScanIntake& operator=(const ScanIntake&) = delete;
+
+  // Starts the worker, first bringing back every scan the session already holds. Call before
+  // anything can submit.
+  void start();
+  void stop();
+
+  // Thread-safe. Returns once the scan is on disk; throws SessionStoreError when it cannot be.
+  StoredScan submit(const std::string& robot, const Pose& estimated, std::int64_t stamp_ns,
+                    PointCloud cloud);
+  // Scans stored but not yet in the live map.
+  std::size_t pending() const;
+
+ private:
+  void loop();
+
+  SessionStore& session_;
+  ScanStore& live_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::pair<StoredScan, PointCloud>> queue_;
+  bool stop_ = false;
+  std::thread worker_;
+};
+
+}  // namespace scanplan::server

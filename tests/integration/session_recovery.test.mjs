@@ -1,0 +1,83 @@
+// Scans fed through POST /api/v1/scans are on disk once acknowledged: a server killed with
+// SIGKILL restarts from its session directory with every scan, pose and the same map.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
+import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { startStack, requireEnv } from '../support/stack.mjs';
+
+const cli = requireEnv('SCANPLAN_CLI');
+const world = join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples/worlds/yard.json');
+const poses = [[-15, -8, 0, 0], [5, -14, 0, 90], [-20, 12, 0, -45]];
+let dir, files, stack;
+
+before(() => {
+  dir = mkdtempSync(join(tmpdir(), 'scanplan-recovery-'));
+  files = poses.map(([x, y, z, yaw], i) => {
+    const out = join(dir, `s${i}.ply`);
+    execFileSync(cli, ['scan', '--world', world, '--at', `${x},${y},${z},${yaw}`, '--out', out,
+      '--seed', String(i + 1)], { stdio: ['ignore', 'ignore', 'ignore'] });
+    return out;
+  });
+});
+after(async () => {
+  if (stack) await stack.stop();
+  rmSync(dir, { recursive: true, force: true });
+});
+
+const post = (s, i) => {
+  const [x, y, z, yaw] = poses[i];
+  return s.api('POST', `/api/v1/scans?x=${x}&y=${y}&z=${z}&yaw_deg=${yaw}`, { body: readFileSync(files[i]) });
+};
+
+test('bad uploads are refused with the right status and nothing is stored', async () => {
+  stack = await startStack({ bridge: false, dir: join(dir, 'run1') });
+  const missing = await stack.api('POST', '/api/v1/scans?x=0&y=0&z=0', { body: readFileSync(files[0]) });
+  assert.equal(missing.status, 400);
+  assert.match((await missing.json()).error.message, /yaw_deg/);
+  const nan = await stack.api('POST', '/api/v1/scans?x=NaN&y=0&z=0&yaw_deg=0', { body: readFileSync(files[0]) });
+  assert.equal(nan.status, 400);
+  const garbage = await stack.api('POST', '/api/v1/scans?x=0&y=0&z=0&yaw_deg=0', { body: 'ply\nformat ascii 1.0\nelement vertex 99999999\n' });
+  assert.equal(garbage.status, 400);
+  assert.equal((await garbage.json()).error.code, 'bad_scan');
+  const viewer = await stack.api('POST', '/api/v1/scans?x=0&y=0&z=0&yaw_deg=0', { auth: stack.viewerToken, body: readFileSync(files[0]) });
+  assert.equal(viewer.status, 403);
+  assert.equal((await (await stack.api('GET', '/api/v1/scans/1')).json()).error.code, 'not_found');
+  assert.equal((await stack.api('GET', '/api/v1/scans/abc')).status, 400);
+  assert.deepEqual((await (await stack.api('GET', '/api/v1/scans')).json()).scans, []);
+});
+
+test('acknowledged scans survive SIGKILL', async () => {
+  for (let i = 0; i < poses.length; i++) {
+    const r = await post(stack, i);
+    assert.equal(r.status, 201);
+    const body = await r.json();
+    assert.equal(body.id, i + 1);
+    assert.deepEqual(body.estimated, { x: poses[i][0], y: poses[i][1], z: poses[i][2], yaw_deg: poses[i][3] });
+  }
+  const before = await stack.waitFor('three scans in the map', async () => {
+    const s = await (await stack.api('GET', '/api/v1/session')).json();
+    return s.scans === 3 ? s : undefined;
+  });
+  const mapBefore = Buffer.from(await (await stack.api('GET', '/api/v1/map.drc')).arrayBuffer());
+  const tokens = { operator: stack.token, viewer: stack.viewerToken };
+  const sessionDir = stack.dir;
+  await stack.stop({ keepDir: true, signal: 'SIGKILL' });
+
+  stack = await startStack({ bridge: false, dir: sessionDir, tokens });
+  const after = await stack.waitFor('the map rebuilt from disk', async () => {
+    const s = await (await stack.api('GET', '/api/v1/session')).json();
+    return s.scans === 3 ? s : undefined;
+  });
+  assert.equal(after.points, before.points);
+  assert.deepEqual(after.bounds, before.bounds);
+  const list = (await (await stack.api('GET', '/api/v1/scans')).json()).scans;
+  assert.deepEqual(list.map((s) => s.id), [1, 2, 3]);
+  assert.deepEqual(list[1].estimated, { x: 5, y: -14, z: 0, yaw_deg: 90 });
+  const mapAfter = Buffer.from(await (await stack.api('GET', '/api/v1/map.drc')).arrayBuffer());
+  assert.ok(mapAfter.equals(mapBefore), 'the page gets the same map after the restart');
+  const next = await post(stack, 0);
+  assert.equal((await next.json()).id, 4, 'ids continue after the restart');
+});
