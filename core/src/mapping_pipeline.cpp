@@ -22,6 +22,13 @@ void MappingPipeline::set_target(TargetRegion target) {
   update_regions();
 }
 
+void MappingPipeline::set_region_configs(const RegionConfig& regions,
+                                         const MovableConfig& movable) {
+  config_.regions = regions;
+  config_.movable = movable;
+  update_regions();
+}
+
 std::vector<Eigen::Vector2d> MappingPipeline::scan_points() const {
   std::vector<Eigen::Vector2d> out;
   out.reserve(poses_.size());

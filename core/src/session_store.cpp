@@ -18,7 +18,8 @@ namespace {
 std::string utc_now() {
   const auto now = std::chrono::system_clock::now();
   const std::time_t t = std::chrono::system_clock::to_time_t(now);
-  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+  const auto ms =
+      std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
   std::tm tm{};
   gmtime_r(&t, &tm);
   char buf[40];
@@ -33,7 +34,8 @@ std::string utc_now() {
 void write_durably(const std::filesystem::path& path, const std::string& bytes) {
   const std::filesystem::path part = path.string() + ".part";
   const int fd = ::open(part.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw SessionStoreError("cannot create " + part.string() + ": " + std::strerror(errno));
+  if (fd < 0)
+    throw SessionStoreError("cannot create " + part.string() + ": " + std::strerror(errno));
   std::size_t done = 0;
   while (done < bytes.size()) {
     const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
@@ -67,7 +69,8 @@ class Statement {
   Statement& bind(int i, double v) { return check(sqlite3_bind_double(stmt_, i, v)); }
   Statement& bind(int i, std::int64_t v) { return check(sqlite3_bind_int64(stmt_, i, v)); }
   Statement& bind(int i, const std::string& v) {
-    return check(sqlite3_bind_text(stmt_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT));
+    return check(
+        sqlite3_bind_text(stmt_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT));
   }
   bool step() {
     const int rc = sqlite3_step(stmt_);
@@ -84,7 +87,8 @@ class Statement {
 
  private:
   Statement& check(int rc) {
-    if (rc != SQLITE_OK) throw SessionStoreError(std::string("session database: ") + sqlite3_errmsg(db_));
+    if (rc != SQLITE_OK)
+      throw SessionStoreError(std::string("session database: ") + sqlite3_errmsg(db_));
     return *this;
   }
   sqlite3* db_;
@@ -113,9 +117,12 @@ StoredScan scan_from_row(const Statement& s) {
 SessionStore::SessionStore(std::filesystem::path dir) : dir_(std::move(dir)) {
   std::error_code ec;
   std::filesystem::create_directories(dir_ / "scans", ec);
-  if (ec) throw SessionStoreError("cannot create the session directory " + dir_.string() + ": " + ec.message());
+  if (ec)
+    throw SessionStoreError("cannot create the session directory " + dir_.string() + ": " +
+                            ec.message());
   const std::string db_path = (dir_ / "session.sqlite").string();
-  if (sqlite3_open_v2(db_path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
+  if (sqlite3_open_v2(db_path.c_str(), &db_,
+                      SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
                       nullptr) != SQLITE_OK) {
     const std::string why = db_ ? sqlite3_errmsg(db_) : "out of memory";
     sqlite3_close(db_);
@@ -126,16 +133,20 @@ SessionStore::SessionStore(std::filesystem::path dir) : dir_(std::move(dir)) {
   // WAL with full sync: a commit is on disk when it returns, and readers never block the writer.
   exec("PRAGMA journal_mode=WAL");
   exec("PRAGMA synchronous=FULL");
-  exec("CREATE TABLE IF NOT EXISTS scans(id INTEGER PRIMARY KEY, robot TEXT NOT NULL, "
-       "est_x REAL, est_y REAL, est_z REAL, est_roll REAL, est_pitch REAL, est_yaw REAL, "
-       "x REAL, y REAL, z REAL, roll REAL, pitch REAL, yaw REAL, stamp_ns INTEGER, "
-       "points INTEGER, file TEXT NOT NULL, received_at TEXT NOT NULL)");
-  exec("CREATE TABLE IF NOT EXISTS events(id INTEGER PRIMARY KEY, at TEXT NOT NULL, "
-       "kind TEXT NOT NULL, json TEXT NOT NULL)");
+  exec(
+      "CREATE TABLE IF NOT EXISTS scans(id INTEGER PRIMARY KEY, robot TEXT NOT NULL, "
+      "est_x REAL, est_y REAL, est_z REAL, est_roll REAL, est_pitch REAL, est_yaw REAL, "
+      "x REAL, y REAL, z REAL, roll REAL, pitch REAL, yaw REAL, stamp_ns INTEGER, "
+      "points INTEGER, file TEXT NOT NULL, received_at TEXT NOT NULL)");
+  exec(
+      "CREATE TABLE IF NOT EXISTS events(id INTEGER PRIMARY KEY, at TEXT NOT NULL, "
+      "kind TEXT NOT NULL, json TEXT NOT NULL)");
   remove_orphans();
 }
 
-SessionStore::~SessionStore() { sqlite3_close(db_); }
+SessionStore::~SessionStore() {
+  sqlite3_close(db_);
+}
 
 void SessionStore::exec(const char* sql) const {
   char* err = nullptr;
@@ -179,7 +190,8 @@ StoredScan SessionStore::add_scan(const std::string& robot, const Pose& estimate
     r.received_at = utc_now();
     write_durably(dir_ / r.file, write_ply_bytes(cloud, {"scanplan robot " + robot}));
     Statement ins(db_, (std::string("INSERT INTO scans(") + kScanColumns +
-                        ") VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)").c_str());
+                        ") VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)")
+                           .c_str());
     const Pose& e = estimated;
     const Pose& p = placed;
     ins.bind(1, r.id).bind(2, robot);

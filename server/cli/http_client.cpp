@@ -39,7 +39,8 @@ HttpClient::HttpClient(const std::string& base, std::chrono::milliseconds timeou
   const auto colon = hostport.rfind(':');
   host_ = colon == std::string::npos ? hostport : hostport.substr(0, colon);
   port_ = colon == std::string::npos ? "80" : hostport.substr(colon + 1);
-  if (host_.empty() || port_.empty()) throw HttpClientError("server URL '" + base + "' has no host");
+  if (host_.empty() || port_.empty())
+    throw HttpClientError("server URL '" + base + "' has no host");
 }
 
 HttpResult HttpClient::request(const std::string& method, const std::string& path,

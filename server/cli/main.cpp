@@ -6,12 +6,14 @@
 
 #include "replay_command.hpp"
 #include "scan_command.hpp"
+#include "simulate_command.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"scanplan: offline tools and terminal operator for the scanplan workstation"};
   app.require_subcommand(1);
   scanplan::cli::add_scan_command(app);
   scanplan::cli::add_replay_command(app);
+  scanplan::cli::add_simulate_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -70,8 +70,9 @@ void match(const json& expected, const json& actual, const std::string& where,
   }
   if (expected.is_array()) {
     if (!actual.is_array() || actual.size() < expected.size()) {
-      errors.push_back(where + ": expected an array of at least " + std::to_string(expected.size()) +
-                       " elements, got " + actual.dump().substr(0, 200));
+      errors.push_back(where + ": expected an array of at least " +
+                       std::to_string(expected.size()) + " elements, got " +
+                       actual.dump().substr(0, 200));
       return;
     }
     for (std::size_t i = 0; i < expected.size(); ++i) {
@@ -82,7 +83,9 @@ void match(const json& expected, const json& actual, const std::string& where,
   const bool same = expected.is_number() && actual.is_number()
                         ? expected.get<double>() == actual.get<double>()
                         : expected == actual;
-  if (!same) errors.push_back(where + ": expected " + expected.dump() + ", got " + actual.dump().substr(0, 200));
+  if (!same)
+    errors.push_back(where + ": expected " + expected.dump() + ", got " +
+                     actual.dump().substr(0, 200));
 }
 
 std::vector<std::string> check(const json& expect, const HttpResult& r) {
@@ -154,14 +157,17 @@ int run_replay(const ReplayArgs& a) {
     } else if (req.contains("body")) {
       const json& b = req.at("body");
       body = b.is_string() ? b.get<std::string>() : b.dump();
-      if (!b.is_string() && !headers.count("Content-Type")) headers["Content-Type"] = "application/json";
+      if (!b.is_string() && !headers.count("Content-Type"))
+        headers["Content-Type"] = "application/json";
     }
     const std::string method = req.value("method", "GET");
     const std::string path = expand(req.at("path").get<std::string>());
     // An extension of the format: "until" repeats the request until it meets its expectations
     // (for what the server does after answering, such as planning), within timeout_s.
-    const double timeout_s = step.contains("until") ? step.at("until").value("timeout_s", 30.0) : 0.0;
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    const double timeout_s =
+        step.contains("until") ? step.at("until").value("timeout_s", 30.0) : 0.0;
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
     std::vector<std::string> errors;
     for (;;) {
       try {
@@ -183,8 +189,11 @@ int run_replay(const ReplayArgs& a) {
       failures.push_back({{"step", i + 1}, {"request", method + " " + path}, {"errors", errors}});
     }
   }
-  std::cout << json{{"name", name}, {"steps", passed + failed}, {"passed", passed},
-                    {"failed", failed}, {"failures", failures}}
+  std::cout << json{{"name", name},
+                    {"steps", passed + failed},
+                    {"passed", passed},
+                    {"failed", failed},
+                    {"failures", failures}}
                    .dump()
             << std::endl;
   std::cerr << passed << " passed, " << failed << " failed\n";

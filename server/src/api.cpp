@@ -48,8 +48,9 @@ double query_number(const Request& r, const std::string& name) {
     used = 0;
   }
   if (used == 0 || used != it->second.size() || !std::isfinite(v)) {
-    throw HttpError(400, "bad_request",
-                    "query parameter '" + name + "' must be a finite number, got '" + it->second + "'");
+    throw HttpError(
+        400, "bad_request",
+        "query parameter '" + name + "' must be a finite number, got '" + it->second + "'");
   }
   return v;
 }
@@ -65,11 +66,12 @@ std::string iso_time(std::chrono::system_clock::time_point t) {
 
 }  // namespace
 
-Api::Api(ScanStore& store, ScanIntake& intake, DdsLink& dds, const Auth& auth,
+Api::Api(ScanStore& store, ScanIntake& intake, DdsLink& dds, Mission& mission, const Auth& auth,
          std::string session_dir)
     : store_(store),
       intake_(intake),
       dds_(dds),
+      mission_(mission),
       auth_(auth),
       session_dir_(std::move(session_dir)),
       started_(std::chrono::system_clock::now()) {}
@@ -99,6 +101,25 @@ void Api::install(http::Router& router) {
   router.add("POST", "/api/v1/scans", [this](const Request& r, const auto&) {
     require(r, Role::kOperator);
     return post_scan(r);
+  });
+  router.add("GET", "/api/v1/candidates", [this](const Request& r, const auto&) {
+    require(r, Role::kViewer);
+    return candidates();
+  });
+  for (const std::string action : {"approve", "reject", "cancel"}) {
+    router.add("POST", "/api/v1/candidates/{id}/" + action,
+               [this, action](const Request& r, const auto& params) {
+                 require(r, Role::kOperator);
+                 return decide(r, params.at("id"), action);
+               });
+  }
+  router.add("GET", "/api/v1/params", [this](const Request& r, const auto&) {
+    require(r, Role::kViewer);
+    return get_params();
+  });
+  router.add("PUT", "/api/v1/params", [this](const Request& r, const auto&) {
+    require(r, Role::kOperator);
+    return put_params(r);
   });
   router.add("POST", "/api/v1/scan", [this](const Request& r, const auto&) {
     require(r, Role::kOperator);
@@ -157,15 +178,29 @@ Response Api::session() const {
   return Response::json(200, j);
 }
 
-Response Api::map_drc(const Request&) const {
-  const auto encoded = store_.encoded_map();
-  if (!encoded) {
-    Response empty;
-    empty.status = 204;
-    return empty;
+Response Api::map_drc(const Request& request) const {
+  ScanStore::EncodedMap encoded;
+  if (const auto it = request.query.find("since"); it != request.query.end()) {
+    std::int64_t since = 0;
+    const auto [end, ec] =
+        std::from_chars(it->second.data(), it->second.data() + it->second.size(), since);
+    if (ec != std::errc() || end != it->second.data() + it->second.size() || since < 0) {
+      throw HttpError(400, "bad_request",
+                      "'since' is a scan id (a whole number ≥ 0), got '" + it->second + "'");
+    }
+    encoded = store_.encoded_since(since);
+  } else {
+    encoded = store_.encoded_map();
   }
-  Response r = Response::bytes(*encoded, "application/octet-stream");
+  Response r;
+  if (encoded.draco) {
+    r = Response::bytes(*encoded.draco, "application/octet-stream");
+  } else {
+    r.status = 204;
+  }
   r.set_header("Cache-Control", "no-store");
+  // The newest scan included, for the next ?since=.
+  r.set_header("X-Scanplan-Last-Scan", std::to_string(encoded.last_scan));
   return r;
 }
 
@@ -214,7 +249,8 @@ Response Api::post_scan(const Request& request) {
     const StoredScan s = intake_.submit(robot, estimated, stamp, std::move(cloud));
     return Response::json(201, scan_json(s));
   } catch (const SessionStoreError& e) {
-    throw HttpError(503, "storage_failed", std::string("the scan could not be stored: ") + e.what());
+    throw HttpError(503, "storage_failed",
+                    std::string("the scan could not be stored: ") + e.what());
   }
 }
 
@@ -234,6 +270,158 @@ Response Api::get_scan(const std::string& id) const {
     if (s.id == n) return Response::json(200, scan_json(s));
   }
   throw HttpError(404, "not_found", "no scan " + id + " in this session");
+}
+
+Response Api::candidates() const {
+  const auto plan = store_.plan();
+  json list = json::array();
+  if (!plan) return Response::json(200, {{"plan", nullptr}, {"candidates", list}});
+  for (const CandidateRecord& r : plan->candidates) {
+    const Candidate& c = r.candidate;
+    json path = json::array();
+    for (const auto& p : c.path) path.push_back({p.x(), p.y()});
+    list.push_back({{"id", r.id},
+                    {"rank", r.rank},
+                    {"state", r.state},
+                    {"note", r.note},
+                    {"x", c.position.x()},
+                    {"y", c.position.y()},
+                    {"z", c.position.z()},
+                    {"f", c.f},
+                    {"gain_unscanned_m2", c.gain_unscanned_m2},
+                    {"gain_low_res_m2", c.gain_low_res_m2},
+                    {"travel_m", c.travel_m},
+                    {"score", c.score},
+                    {"path", path}});
+  }
+  return Response::json(200, {{"plan",
+                               {{"id", plan->id},
+                                {"based_on_scan", plan->based_on_scan},
+                                {"robot", plan->robot},
+                                {"policy", plan->policy},
+                                {"alpha", plan->alpha},
+                                {"plan_ms", plan->plan_ms}}},
+                              {"candidates", list}});
+}
+
+namespace {
+
+json params_json(const MissionParams& p) {
+  json target = nullptr;
+  if (p.target) {
+    target = json::array();
+    for (const auto& c : p.target->corners()) target.push_back({c.x(), c.y()});
+  }
+  return {{"alpha", p.planner.alpha},
+          {"policy", std::string(policy_name(p.planner.policy))},
+          {"max_candidates", p.planner.max_candidates},
+          {"travel_cost_per_m", p.planner.travel_cost_per_m},
+          {"completed_radius_m", p.planner.regions.completed_radius_m},
+          {"max_step_m", p.planner.movable.max_step_m},
+          {"target", target}};
+}
+
+double number_in(const json& j, const char* key, double lo, double hi) {
+  const json& v = j.at(key);
+  if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < lo ||
+      v.get<double>() > hi) {
+    throw HttpError(400, "bad_request",
+                    std::string("'") + key + "' must be a number within " + std::to_string(lo) +
+                        ".." + std::to_string(hi));
+  }
+  return v.get<double>();
+}
+
+}  // namespace
+
+Response Api::decide(const Request& request, const std::string& id, const std::string& action) {
+  std::uint64_t n = 0;
+  const auto [end, ec] = std::from_chars(id.data(), id.data() + id.size(), n);
+  if (ec != std::errc() || end != id.data() + id.size() || n == 0) {
+    throw HttpError(400, "bad_request",
+                    "a candidate id is a positive whole number, got '" + id + "'");
+  }
+  // Who decided: the operator may name themselves; the token's role is recorded regardless.
+  std::string by = "operator", reason;
+  if (!request.body.empty()) {
+    json body;
+    try {
+      body = json::parse(request.body);
+    } catch (const json::parse_error&) {
+      throw HttpError(400, "bad_request",
+                      "the body, when given, must be JSON like {\"by\": \"name\"}");
+    }
+    if (body.contains("by") && body["by"].is_string())
+      by = "operator " + body["by"].get<std::string>();
+    if (body.contains("reason") && body["reason"].is_string())
+      reason = body["reason"].get<std::string>();
+  }
+  try {
+    json out;
+    if (action == "approve") out = mission_.approve(n, by);
+    if (action == "reject") out = mission_.reject(n, by, reason);
+    if (action == "cancel") out = mission_.cancel(n, by);
+    return Response::json(200, out);
+  } catch (const MissionError& e) {
+    throw HttpError(e.status, e.code, e.what());
+  }
+}
+
+Response Api::get_params() const {
+  return Response::json(200, params_json(store_.params()));
+}
+
+Response Api::put_params(const Request& request) {
+  json body;
+  try {
+    body = json::parse(request.body);
+  } catch (const json::parse_error&) {
+    throw HttpError(400, "bad_request", "the body must be a JSON object of parameters");
+  }
+  if (!body.is_object()) throw HttpError(400, "bad_request", "the body must be a JSON object");
+  MissionParams p = store_.params();
+  for (const auto& [key, value] : body.items()) {
+    if (key == "alpha") {
+      p.planner.alpha = number_in(body, "alpha", 0, 1);
+    } else if (key == "policy") {
+      const auto policy = value.is_string() ? parse_policy(value.get<std::string>()) : std::nullopt;
+      if (!policy) {
+        throw HttpError(400, "bad_request",
+                        "'policy' must be paper, exhaustive, travel, nearest-frontier or random");
+      }
+      p.planner.policy = *policy;
+    } else if (key == "max_candidates") {
+      p.planner.max_candidates = static_cast<int>(number_in(body, "max_candidates", 1, 50));
+    } else if (key == "travel_cost_per_m") {
+      p.planner.travel_cost_per_m = number_in(body, "travel_cost_per_m", 0, 1e6);
+    } else if (key == "completed_radius_m") {
+      p.planner.regions.completed_radius_m = number_in(body, "completed_radius_m", 1, 200);
+    } else if (key == "max_step_m") {
+      p.planner.movable.max_step_m = number_in(body, "max_step_m", 0.01, 2);
+    } else if (key == "target") {
+      std::vector<Eigen::Vector2d> corners;
+      if (value.is_array()) {
+        for (const auto& c : value) {
+          if (!c.is_array() || c.size() != 2 || !c[0].is_number() || !c[1].is_number()) {
+            corners.clear();
+            break;
+          }
+          corners.emplace_back(c[0].get<double>(), c[1].get<double>());
+        }
+      }
+      try {
+        p.target = TargetRegion::polygon(corners);
+      } catch (const std::invalid_argument& e) {
+        throw HttpError(
+            400, "bad_request",
+            std::string("'target' must be [[x, y], ...] with at least 3 corners: ") + e.what());
+      }
+    } else {
+      throw HttpError(400, "bad_request", "unknown parameter '" + key + "'");
+    }
+  }
+  store_.set_params(p);
+  return Response::json(200, params_json(store_.params()));
 }
 
 Response Api::request_scan(const Request& request) {

@@ -6,6 +6,7 @@
 #include "auth.hpp"
 #include "dds_link.hpp"
 #include "http/router.hpp"
+#include "mission.hpp"
 #include "scan_store.hpp"
 
 namespace scanplan::server {
@@ -14,7 +15,7 @@ namespace scanplan::server {
 // link and back; they hold no state of their own beyond the session's start time.
 class Api {
  public:
-  Api(ScanStore& store, ScanIntake& intake, DdsLink& dds, const Auth& auth,
+  Api(ScanStore& store, ScanIntake& intake, DdsLink& dds, Mission& mission, const Auth& auth,
       std::string session_dir);
   void install(http::Router& router);
 
@@ -30,10 +31,16 @@ class Api {
   http::Response post_scan(const http::Request& request);
   http::Response list_scans() const;
   http::Response get_scan(const std::string& id) const;
+  http::Response candidates() const;
+  http::Response get_params() const;
+  http::Response put_params(const http::Request& request);
+  http::Response decide(const http::Request& request, const std::string& id,
+                        const std::string& action);
 
   ScanStore& store_;
   ScanIntake& intake_;
   DdsLink& dds_;
+  Mission& mission_;
   const Auth& auth_;
   std::string session_dir_;
   std::chrono::system_clock::time_point started_;

@@ -26,7 +26,10 @@ Role Auth::role_of(const http::Request& request) const {
   if (header->size() <= kBearer.size() || header->substr(0, kBearer.size()) != kBearer) {
     return Role::kNone;
   }
-  const std::string_view token = header->substr(kBearer.size());
+  return role_of_token(header->substr(kBearer.size()));
+}
+
+Role Auth::role_of_token(std::string_view token) const {
   if (same_token(operator_token_, token)) return Role::kOperator;
   if (same_token(viewer_token_, token)) return Role::kViewer;
   return Role::kNone;

@@ -13,6 +13,7 @@ class Auth {
  public:
   Auth(std::string operator_token, std::string viewer_token);
   Role role_of(const http::Request& request) const;
+  Role role_of_token(std::string_view token) const;
   // 128 random bits as hex, for a session started without a configured token.
   static std::string random_token();
 

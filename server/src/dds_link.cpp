@@ -26,8 +26,9 @@ std::string str(const char* s) {
 
 }  // namespace
 
-DdsLink::DdsLink(std::uint32_t domain_id, ScanStore& store, ScanIntake& intake)
-    : store_(store), intake_(intake), participant_(domain_id) {
+DdsLink::DdsLink(std::uint32_t domain_id, ScanStore& store, ScanIntake& intake,
+                 const Events& events)
+    : store_(store), intake_(intake), events_(events), participant_(domain_id) {
   using dds::QosKind;
   auto& p = participant_;
   points_reader_ =
@@ -41,6 +42,7 @@ DdsLink::DdsLink(std::uint32_t domain_id, ScanStore& store, ScanIntake& intake)
   progress_reader_ = p.reader(scanplan_ScanProgress_desc, topics::kScanProgress, QosKind::kStatus);
   status_reader_ = p.reader(scanplan_RobotStatus_desc, topics::kRobotStatus, QosKind::kStatus);
   scan_cmd_writer_ = p.writer(scanplan_ScanCommand_desc, topics::kScanCommand, QosKind::kCommand);
+  move_cmd_writer_ = p.writer(scanplan_MoveCommand_desc, topics::kMoveCommand, QosKind::kCommand);
 }
 
 DdsLink::~DdsLink() {
@@ -65,6 +67,24 @@ std::uint32_t DdsLink::request_scan(const std::string& robot_id) {
   cmd.robot_id = const_cast<char*>(robot_id.c_str());
   cmd.command_id = next_command_id_++;
   dds::check(dds_write(scan_cmd_writer_, &cmd), "sending the scan command");
+  return cmd.command_id;
+}
+
+std::uint32_t DdsLink::request_move(const std::string& robot_id, double x, double y,
+                                    double yaw_deg) {
+  dds_publication_matched_status_t st;
+  dds::check(dds_get_publication_matched_status(move_cmd_writer_, &st), "reading matched status");
+  if (st.current_count == 0) {
+    throw NoScannerError("no robot bridge is connected on DDS to take the move command");
+  }
+  std::lock_guard lock(command_mutex_);
+  scanplan_MoveCommand cmd{};
+  cmd.robot_id = const_cast<char*>(robot_id.c_str());
+  cmd.command_id = next_command_id_++;
+  cmd.x = x;
+  cmd.y = y;
+  cmd.yaw_deg = yaw_deg;
+  dds::check(dds_write(move_cmd_writer_, &cmd), "sending the move command");
   return cmd.command_id;
 }
 
@@ -94,6 +114,11 @@ void DdsLink::take_samples() {
   dds::take_all<scanplan_ScanProgress>(progress_reader_, [&](const scanplan_ScanProgress& p) {
     store_.set_scan_state(str(p.robot_id),
                           {p.command_id, str(p.state), p.fraction, str(p.message)});
+    events_.publish("scan_progress", {{"robot", str(p.robot_id)},
+                                      {"command_id", p.command_id},
+                                      {"state", str(p.state)},
+                                      {"fraction", p.fraction},
+                                      {"message", str(p.message)}});
   });
   dds::take_all<scanplan_RobotStatus>(status_reader_, [&](const scanplan_RobotStatus& s) {
     Pose pose;
@@ -101,7 +126,18 @@ void DdsLink::take_samples() {
     pose.y = s.y;
     pose.z = s.z;
     pose.yaw = deg2rad(s.yaw_deg);
-    store_.set_robot_status(str(s.robot_id), {s.command_id, str(s.state), str(s.message), pose});
+    const RobotStatus status{s.command_id, str(s.state), str(s.message), pose};
+    store_.set_robot_status(str(s.robot_id), status);
+    // The once-a-second idle heartbeat is not news.
+    if (status.state != "idle" || status.command_id != 0) {
+      events_.publish("robot_status",
+                      {{"robot", str(s.robot_id)},
+                       {"command_id", s.command_id},
+                       {"state", status.state},
+                       {"message", status.message},
+                       {"pose", {{"x", s.x}, {"y", s.y}, {"z", s.z}, {"yaw_deg", s.yaw_deg}}}});
+    }
+    if (on_status) on_status(str(s.robot_id), status);
   });
   const auto key_of = [](const std_msgs_msg_dds__Header_& h) {
     return Key{dds::robot_id_of(h.frame_id), dds::stamp_ns(h.stamp)};

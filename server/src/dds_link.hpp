@@ -3,6 +3,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -11,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "events.hpp"
 #include "scan_intake.hpp"
 #include "scan_store.hpp"
 #include "scanplan/core/panorama_camera.hpp"
@@ -29,7 +31,7 @@ class NoScannerError : public std::runtime_error {
 // commands on behalf of the API.
 class DdsLink {
  public:
-  DdsLink(std::uint32_t domain_id, ScanStore& store, ScanIntake& intake);
+  DdsLink(std::uint32_t domain_id, ScanStore& store, ScanIntake& intake, const Events& events);
   ~DdsLink();
   DdsLink(const DdsLink&) = delete;
   DdsLink& operator=(const DdsLink&) = delete;
@@ -40,8 +42,13 @@ class DdsLink {
   // Asks `robot_id` (empty: every robot) for one scan; returns the command id.
   // Throws NoScannerError when no bridge is listening for commands.
   std::uint32_t request_scan(const std::string& robot_id);
+  // Sends `robot_id` to (x, y) facing yaw; returns the command id. Throws NoScannerError when no
+  // bridge listens for move commands.
+  std::uint32_t request_move(const std::string& robot_id, double x, double y, double yaw_deg);
   // Bridges currently subscribed to scan commands.
   int connected_bridges() const;
+  // Called on the DDS thread with every status a robot reports (set before start()).
+  std::function<void(const std::string& robot, const RobotStatus& status)> on_status;
 
  private:
   // The parts of one scan, which travel on four topics and may arrive in any order.
@@ -63,9 +70,10 @@ class DdsLink {
 
   ScanStore& store_;
   ScanIntake& intake_;
+  const Events& events_;
   dds::Participant participant_;
   dds_entity_t points_reader_, pose_reader_, image_reader_, camera_info_reader_, progress_reader_,
-      status_reader_, scan_cmd_writer_;
+      status_reader_, scan_cmd_writer_, move_cmd_writer_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
   std::mutex command_mutex_;

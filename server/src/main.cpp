@@ -11,9 +11,12 @@
 #include "api.hpp"
 #include "auth.hpp"
 #include "dds_link.hpp"
+#include "events.hpp"
 #include "http/http_server.hpp"
 #include "http/router.hpp"
 #include "http/static_files.hpp"
+#include "http/websocket_handshake.hpp"
+#include "http/websocket_hub.hpp"
 #include "scan_store.hpp"
 
 #ifndef SCANPLAN_DEFAULT_WEB_DIR
@@ -63,18 +66,39 @@ int main(int argc, char** argv) {
     const srv::Auth auth(operator_token, env_or_empty("SCANPLAN_VIEWER_TOKEN"));
 
     scanplan::SessionStore session(session_dir);
+    http::HubConfig hub_config;
+    // A dense scan's Draco chunk is a few MB; a browser may lag one or two behind.
+    hub_config.max_queued_binary_bytes = 16u << 20;
+    hub_config.log = [](std::string_view msg) { spdlog::warn("events: {}", msg); };
+    http::WebSocketHub hub(hub_config);
+    const srv::Events events(&hub);
     srv::ScanStore store;
-    srv::ScanIntake intake(session, store);
-    srv::DdsLink dds(domain, store, intake);
-    srv::Api api(store, intake, dds, auth, session_dir);
+    srv::ScanIntake intake(session, store, events);
+    srv::DdsLink dds(domain, store, intake, events);
+    srv::Mission mission(store, dds, session, events);
+    dds.on_status = [&mission](const std::string& robot, const srv::RobotStatus& status) {
+      mission.on_status(robot, status);
+    };
+    srv::Api api(store, intake, dds, mission, auth, session_dir);
     http::Router router([](std::string_view msg) { spdlog::error("{}", msg); });
     api.install(router);
+    // Browsers cannot set headers on a WebSocket: the token may come as ?token=.
+    router.add("GET", "/api/v1/events", [&](const http::Request& r, const http::Router::Params&) {
+      const auto q = r.query.find("token");
+      const srv::Role role = q != r.query.end() ? auth.role_of_token(q->second) : auth.role_of(r);
+      if (role == srv::Role::kNone) {
+        return http::Response::error(
+            401, "unauthorized", "a valid token is required: ?token=T or Authorization: Bearer T");
+      }
+      return http::websocket_handshake_response(r, hub.adopt(r.peer));
+    });
     const http::StaticFiles files(web_dir);
     router.set_fallback(
         [&files](const http::Request& r, const http::Router::Params&) { return files.serve(r); });
 
     http::HttpServer server(config, [&router](const http::Request& r) { return router.route(r); });
     server.start();
+    hub.start();
     intake.start();
     dds.start();
     g_server = &server;
@@ -90,6 +114,7 @@ int main(int argc, char** argv) {
     g_server = nullptr;
     dds.stop();
     intake.stop();
+    hub.stop();
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 1;

@@ -4,9 +4,12 @@
 
 namespace scanplan::server {
 
-ScanIntake::ScanIntake(SessionStore& session, ScanStore& live) : session_(session), live_(live) {}
+ScanIntake::ScanIntake(SessionStore& session, ScanStore& live, const Events& events)
+    : session_(session), live_(live), events_(events) {}
 
-ScanIntake::~ScanIntake() { stop(); }
+ScanIntake::~ScanIntake() {
+  stop();
+}
 
 void ScanIntake::start() {
   {
@@ -24,7 +27,7 @@ void ScanIntake::start() {
         if (stop_) return;
       }
       try {
-        live_.add(s, session_.load_points(s));
+        process(s, session_.load_points(s));
       } catch (const std::exception& e) {
         spdlog::error("scan {} of the session cannot be read back: {}", s.id, e.what());
       }
@@ -51,7 +54,27 @@ StoredScan ScanIntake::submit(const std::string& robot, const Pose& estimated,
     queue_.emplace_back(stored, std::move(cloud));
   }
   wake_.notify_one();
+  events_.publish("scan_received",
+                  {{"scan", stored.id}, {"robot", robot}, {"points", stored.points}});
   return stored;
+}
+
+void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud) {
+  live_.add(scan, cloud);
+  if (const auto chunk = live_.encoded_chunk(scan.id)) events_.map_chunk(scan.id, *chunk);
+  const MapAreas a = live_.areas();
+  events_.publish("map_updated", {{"scan", scan.id},
+                                  {"points", scan.points},
+                                  {"completed_m2", a.completed_m2},
+                                  {"low_resolution_m2", a.low_resolution_m2},
+                                  {"unscanned_m2", a.unscanned_m2},
+                                  {"movable_m2", a.movable_m2}});
+  if (const auto plan = live_.plan()) {
+    events_.publish("plan_done", {{"plan", plan->id},
+                                  {"based_on_scan", plan->based_on_scan},
+                                  {"candidates", plan->candidates.size()},
+                                  {"plan_ms", plan->plan_ms}});
+  }
 }
 
 std::size_t ScanIntake::pending() const {
@@ -69,7 +92,7 @@ void ScanIntake::loop() {
       next = std::move(queue_.front());
     }
     try {
-      live_.add(next.first, next.second);
+      process(next.first, next.second);
       spdlog::info("scan {} from '{}' is in the map: {} points at ({:.2f}, {:.2f}, {:.2f})",
                    next.first.id, next.first.robot, next.first.points, next.first.placed.x,
                    next.first.placed.y, next.first.placed.z);

@@ -7,6 +7,7 @@
 #include <thread>
 #include <utility>
 
+#include "events.hpp"
 #include "scan_store.hpp"
 #include "scanplan/core/session_store.hpp"
 
@@ -17,7 +18,7 @@ namespace scanplan::server {
 // so neither the network thread nor the DDS thread waits on the map, the layers or Draco.
 class ScanIntake {
  public:
-  ScanIntake(SessionStore& session, ScanStore& live);
+  ScanIntake(SessionStore& session, ScanStore& live, const Events& events);
   ~ScanIntake();
   ScanIntake(const ScanIntake&) = delete;
   ScanIntake& operator=(const ScanIntake&) = delete;
@@ -35,9 +36,12 @@ class ScanIntake {
 
  private:
   void loop();
+  // Brings one stored scan into the live map and tells the browsers.
+  void process(const StoredScan& scan, const PointCloud& cloud);
 
   SessionStore& session_;
   ScanStore& live_;
+  const Events& events_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;
   std::deque<std::pair<StoredScan, PointCloud>> queue_;

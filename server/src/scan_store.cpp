@@ -1,11 +1,13 @@
 #include "scan_store.hpp"
 
 #include "scanplan/core/draco_codec.hpp"
+#include "scanplan/core/plan_view.hpp"
 #include "scanplan/core/top_view.hpp"
 
 namespace scanplan::server {
 
-ScanStore::ScanStore(PipelineConfig pipeline) : pipeline_(pipeline) {}
+ScanStore::ScanStore(PipelineConfig pipeline, PlannerConfig planner)
+    : pipeline_(pipeline), planner_(planner) {}
 
 const std::vector<std::string>& ScanStore::layer_names() {
   static const std::vector<std::string> kNames = {"regions", "elevation", "movable"};
@@ -31,31 +33,105 @@ void ScanStore::add(const StoredScan& scan, const PointCloud& cloud) {
     next = map_;
   }
   next.append(placed);
-  std::shared_ptr<const std::string> encoded;
+  std::shared_ptr<const std::string> encoded, chunk;
   if (!next.empty()) encoded = std::make_shared<const std::string>(encode_draco(next));
+  if (!placed.empty()) chunk = std::make_shared<const std::string>(encode_draco(placed));
 
   pipeline_.add_scan(cloud, pose);
-  std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> layers;
-  MapAreas areas;
-  if (pipeline_.regions() && pipeline_.movable()) {
-    const RegionMap& regions = *pipeline_.regions();
-    const MovableRegion& movable = *pipeline_.movable();
-    const auto png = [](const cv::Mat& img) {
-      return std::make_shared<const std::vector<std::uint8_t>>(encode_png(img));
-    };
-    layers["regions"] = png(render_regions(regions, &movable, pipeline_.scan_points()));
-    layers["elevation"] = png(render_elevation(pipeline_.map(), regions));
-    layers["movable"] = png(render_movable(pipeline_.map(), movable, regions));
-    areas = {regions.completed_m2(), regions.low_resolution_m2(), regions.unscanned_m2(),
-             movable.area_m2()};
-  }
+  last_scan_ = {scan.id, scan.robot};
+  refresh_derived([&] {
+    scans_.push_back(scan);
+    offsets_.push_back(map_.size());
+    chunks_[scan.id] = chunk;
+    map_ = std::move(next);
+    encoded_ = std::move(encoded);
+  });
+}
 
+void ScanStore::refresh_derived(const std::function<void()>& commit) {
+  if (!pipeline_.regions() || !pipeline_.movable()) {
+    std::lock_guard lock(mutex_);
+    if (commit) commit();
+    return;
+  }
+  const RegionMap& regions = *pipeline_.regions();
+  const MovableRegion& movable = *pipeline_.movable();
+  const Pose robot = pipeline_.scan_poses().back();
+  const std::vector<Eigen::Vector2d> points = pipeline_.scan_points();
+  const Plan plan = plan_next_scan(
+      {pipeline_.map(), *pipeline_.target(), points, Eigen::Vector3d(robot.x, robot.y, robot.z)},
+      planner_);
+
+  PlanRecord record;
+  record.id = next_plan_id_++;
+  record.based_on_scan = last_scan_.first;
+  record.robot = last_scan_.second;
+  for (std::size_t k = 0; k < plan.ranked.size(); ++k) {
+    CandidateRecord c;
+    c.id = next_candidate_id_++;
+    c.rank = static_cast<int>(k + 1);
+    c.candidate = plan.ranked[k];
+    record.candidates.push_back(std::move(c));
+  }
+  record.policy = std::string(policy_name(planner_.policy));
+  record.alpha = planner_.alpha;
+  record.plan_ms = plan.plan_ms;
+
+  const auto png = [](const cv::Mat& img) {
+    return std::make_shared<const std::vector<std::uint8_t>>(encode_png(img));
+  };
+  std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> layers;
+  cv::Mat regions_img = render_regions(regions, &movable, points);
+  draw_plan(regions_img, regions, plan.ranked, std::nullopt);
+  layers["regions"] = png(regions_img);
+  layers["elevation"] = png(render_elevation(pipeline_.map(), regions));
+  layers["movable"] = png(render_movable(pipeline_.map(), movable, regions));
+  const MapAreas areas{regions.completed_m2(), regions.low_resolution_m2(), regions.unscanned_m2(),
+                       movable.area_m2()};
+
+  // The scan, its map and everything derived from it appear to readers together.
   std::lock_guard lock(mutex_);
-  scans_.push_back(scan);
-  map_ = std::move(next);
-  encoded_ = std::move(encoded);
+  if (commit) commit();
+  if (plan_) {
+    for (auto& c : plan_->candidates) {
+      if (c.state == "proposed") c.state = "superseded";
+    }
+  }
+  plan_ = std::move(record);
   layers_ = std::move(layers);
   areas_ = areas;
+}
+
+std::optional<PlanRecord> ScanStore::plan() const {
+  std::lock_guard lock(mutex_);
+  return plan_;
+}
+
+bool ScanStore::set_candidate_state(std::uint64_t id, const std::string& state,
+                                    const std::string& note) {
+  std::lock_guard lock(mutex_);
+  if (!plan_) return false;
+  for (auto& c : plan_->candidates) {
+    if (c.id == id) {
+      c.state = state;
+      c.note = note;
+      return true;
+    }
+  }
+  return false;
+}
+
+MissionParams ScanStore::params() const {
+  std::lock_guard lock(encode_mutex_);
+  return {planner_, pipeline_.target()};
+}
+
+void ScanStore::set_params(const MissionParams& params) {
+  std::lock_guard encode_lock(encode_mutex_);
+  planner_ = params.planner;
+  pipeline_.set_region_configs(params.planner.regions, params.planner.movable);
+  if (params.target) pipeline_.set_target(*params.target);
+  refresh_derived({});
 }
 
 std::vector<StoredScan> ScanStore::scans() const {
@@ -78,12 +154,44 @@ Bounds3 ScanStore::bounds() const {
   return bounds_of(map_);
 }
 
-std::shared_ptr<const std::string> ScanStore::encoded_map() const {
+ScanStore::EncodedMap ScanStore::encoded_map() const {
   std::lock_guard lock(mutex_);
-  return encoded_;
+  return {encoded_, scans_.empty() ? 0 : scans_.back().id};
 }
 
-std::shared_ptr<const std::vector<std::uint8_t>> ScanStore::layer_png(const std::string& name) const {
+std::shared_ptr<const std::string> ScanStore::encoded_chunk(std::int64_t id) const {
+  std::lock_guard lock(mutex_);
+  const auto it = chunks_.find(id);
+  return it == chunks_.end() ? nullptr : it->second;
+}
+
+ScanStore::EncodedMap ScanStore::encoded_since(std::int64_t since_id) const {
+  PointCloud tail;
+  std::int64_t last = 0;
+  {
+    std::lock_guard lock(mutex_);
+    if (scans_.empty()) return {};
+    last = scans_.back().id;
+    std::size_t first = scans_.size();
+    for (std::size_t i = 0; i < scans_.size(); ++i) {
+      if (scans_[i].id > since_id) {
+        first = i;
+        break;
+      }
+    }
+    if (first == scans_.size()) return {nullptr, last};
+    // The common case, one scan behind, is already encoded.
+    if (first + 1 == scans_.size()) return {chunks_.at(scans_[first].id), last};
+    const std::size_t from = offsets_[first];
+    tail.points.assign(map_.points.begin() + from, map_.points.end());
+    tail.colors.assign(map_.colors.begin() + from, map_.colors.end());
+  }
+  if (tail.empty()) return {nullptr, last};
+  return {std::make_shared<const std::string>(encode_draco(tail)), last};
+}
+
+std::shared_ptr<const std::vector<std::uint8_t>> ScanStore::layer_png(
+    const std::string& name) const {
   std::lock_guard lock(mutex_);
   const auto it = layers_.find(name);
   return it == layers_.end() ? nullptr : it->second;

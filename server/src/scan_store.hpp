@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -10,6 +11,7 @@
 #include "scanplan/core/mapping_pipeline.hpp"
 #include "scanplan/core/point_cloud.hpp"
 #include "scanplan/core/pose.hpp"
+#include "scanplan/core/scan_planner.hpp"
 #include "scanplan/core/session_store.hpp"
 
 namespace scanplan::server {
@@ -40,12 +42,38 @@ struct MapAreas {
   double completed_m2 = 0, low_resolution_m2 = 0, unscanned_m2 = 0, movable_m2 = 0;
 };
 
+// One suggested scan point as the operator sees it.
+struct CandidateRecord {
+  std::uint64_t id = 0;  // unique in the session, across plans
+  int rank = 0;          // 1 = best
+  Candidate candidate;
+  std::string state =
+      "proposed";    // proposed, approved, rejected, moving, refused, reached, superseded
+  std::string note;  // why, for refused
+};
+
+struct PlanRecord {
+  std::uint64_t id = 0;
+  std::int64_t based_on_scan = 0;
+  std::string robot;
+  std::string policy;
+  double alpha = 0;
+  double plan_ms = 0;
+  std::vector<CandidateRecord> candidates;
+};
+
+// What the operator can change while the mission runs (PUT /api/v1/params).
+struct MissionParams {
+  PlannerConfig planner;
+  std::optional<TargetRegion> target;  // nothing: the pipeline's default square
+};
+
 // The scans of this session, in the map frame, with what is derived from them: the map's Draco
 // encoding, the MLS map with its regions, and the top-view layers as PNG. All of it is rebuilt
 // off the network thread each time a scan lands, so serving never waits on an encoder.
 class ScanStore {
  public:
-  explicit ScanStore(PipelineConfig pipeline = {});
+  explicit ScanStore(PipelineConfig pipeline = {}, PlannerConfig planner = {});
 
   // A stored scan joins the map: `cloud` is in the scan's own frame, `scan.placed` puts it in
   // the map frame. Scans must come in id order.
@@ -55,12 +83,29 @@ class ScanStore {
   std::size_t scan_count() const;
   std::size_t point_count() const;
   Bounds3 bounds() const;
-  // Null while the map is empty.
-  std::shared_ptr<const std::string> encoded_map() const;
+  struct EncodedMap {
+    std::shared_ptr<const std::string> draco;  // null when there are no points
+    std::int64_t last_scan = 0;                // the newest scan included
+  };
+  EncodedMap encoded_map() const;
+  // The points of the scans after `since_id` only: what a browser that already holds the map
+  // up to that scan needs.
+  EncodedMap encoded_since(std::int64_t since_id) const;
+  // Scan `id`'s own points in the map frame, Draco-encoded; null for an unknown id.
+  std::shared_ptr<const std::string> encoded_chunk(std::int64_t id) const;
   // A top-view layer as PNG: "regions", "elevation" or "movable"; null before the first scan.
   std::shared_ptr<const std::vector<std::uint8_t>> layer_png(const std::string& name) const;
   static const std::vector<std::string>& layer_names();
   MapAreas areas() const;
+
+  // The latest plan (nothing before the first scan).
+  std::optional<PlanRecord> plan() const;
+  // Sets a candidate's state; false when the id is not in the latest plan.
+  bool set_candidate_state(std::uint64_t id, const std::string& state,
+                           const std::string& note = "");
+  MissionParams params() const;
+  // Applies new parameters and recomputes regions, layers and the plan.
+  void set_params(const MissionParams& params);
 
   void set_scan_state(const std::string& robot_id, RobotScanState state);
   void set_robot_status(const std::string& robot_id, RobotStatus status);
@@ -71,11 +116,21 @@ class ScanStore {
   std::vector<StoredScan> scans_;
   PointCloud map_;
   std::shared_ptr<const std::string> encoded_;
+  std::vector<std::size_t> offsets_;  // where each scan's points start in map_
+  std::map<std::int64_t, std::shared_ptr<const std::string>> chunks_;
   std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> layers_;
   MapAreas areas_;
-  MappingPipeline pipeline_;  // written only under encode_mutex_
+  MappingPipeline pipeline_;                                // written only under encode_mutex_
+  PlannerConfig planner_;                                   // written only under encode_mutex_
+  std::pair<std::int64_t, std::string> last_scan_;          // id and robot; under encode_mutex_
+  std::uint64_t next_plan_id_ = 1, next_candidate_id_ = 1;  // under encode_mutex_
+  std::optional<PlanRecord> plan_;
   std::map<std::string, RobotState> robots_;
-  std::mutex encode_mutex_;  // one encoder run at a time; readers keep the previous result
+  mutable std::mutex encode_mutex_;  // one writer at a time; readers keep the previous result
+
+  // Recomputes layers, areas and the plan from the pipeline and publishes them together with
+  // whatever `commit` changes (run under mutex_); needs encode_mutex_ held.
+  void refresh_derived(const std::function<void()>& commit);
 };
 
 }  // namespace scanplan::server

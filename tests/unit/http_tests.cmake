@@ -10,6 +10,10 @@ add_executable(scanplan_http_tests
   ${CMAKE_CURRENT_LIST_DIR}/http_router_test.cpp
   ${CMAKE_CURRENT_LIST_DIR}/http_static_files_test.cpp
   ${CMAKE_CURRENT_LIST_DIR}/http_server_test.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/websocket_frame_test.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/websocket_handshake_test.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/websocket_hub_test.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/websocket_utf8_test.cpp
 )
 target_link_libraries(scanplan_http_tests PRIVATE scanplan_http GTest::gtest_main)
 gtest_discover_tests(scanplan_http_tests

@@ -32,6 +32,8 @@ class MappingPipeline {
   // order; `pose` places it in the map.
   InsertStats add_scan(const PointCloud& cloud, const Pose& pose);
   void set_target(TargetRegion target);
+  // New thresholds for segmentation (completed radius) and the movable region (step height).
+  void set_region_configs(const RegionConfig& regions, const MovableConfig& movable);
 
   const MlsMap& map() const { return map_; }
   const std::vector<Pose>& scan_poses() const { return poses_; }

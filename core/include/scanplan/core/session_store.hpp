@@ -27,7 +27,7 @@ struct StoredScan {
   Pose placed;     // where the map put the scan (after matching)
   std::int64_t stamp_ns = 0;
   std::size_t points = 0;
-  std::string file;  // the scan's PLY, relative to the session directory
+  std::string file;         // the scan's PLY, relative to the session directory
   std::string received_at;  // UTC, ISO 8601
 };
 

@@ -1,0 +1,52 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "scanplan/core/ndt_grid.hpp"
+#include "scanplan/core/point_cloud.hpp"
+#include "scanplan/core/registration_result.hpp"
+
+namespace scanplan {
+
+struct NdtConfig {
+  // Paper §4.2 "Narrower NDT": the grid starts large for a global match and shrinks,
+  // 20 m → 15 m → 10 m. RegistrationConfig scales these for short-range data.
+  std::vector<double> cell_sizes_m{20.0, 15.0, 10.0};
+  int max_iterations = 30;  // Newton steps per cell size
+  // Yaw offsets (degrees) from which the first cell size is also started; the start ending at
+  // the lowest NDT cost goes on to the finer cells. A reported yaw off by 15° or more puts
+  // the far walls metres away, outside the basin of a local optimiser; a few turned starts at
+  // the coarsest (cheapest) cell size widen it. {0}: the initial guess only.
+  std::vector<double> yaw_hypotheses_deg{0.0};
+  // Magnusson's p_o, the share of points the score treats as outliers (Magnusson 2009 eq. 6.7;
+  // PCL's default too). It shapes the score: a larger value flattens it far from a Gaussian.
+  double outlier_ratio = 0.55;
+  // At each cell size the source is thinned to one centroid per cube of cell × this: a 20 m
+  // Gaussian cannot use detail finer than about a metre, and fewer points are faster.
+  double source_voxel_per_cell = 0.05;
+  NdtGridOptions grid;
+  // A Newton step moves at most cell × this and turns at most max_step_rad: far from the
+  // optimum the quadratic model overshoots, and the line search works from a bounded step.
+  double max_step_per_cell = 0.25;
+  double max_step_rad = 0.15;
+  // Stop at a cell size when a step moves less than cell × this and turns less than this.
+  double translation_tolerance_per_cell = 2e-4;
+  double rotation_tolerance_rad = 2e-5;
+  // Fewer source points than this near a Gaussian means the clouds do not overlap at that cell
+  // size: the match is abandoned rather than reported on too little evidence.
+  int min_matched_points = 20;
+  int num_threads = 0;  // OpenMP threads for the score sums; 0: the OpenMP default
+};
+
+// Narrower NDT (paper §4.2; NDT after Magnusson 2009 ch. 6): for each cell size in turn, the
+// target's normal distributions and a Newton optimisation of the Gaussian score (Eq. 3) with its
+// analytic gradient and Hessian, and a backtracking (Armijo) line search. The Hessian is made
+// positive definite by taking the magnitude of its eigenvalues, so every step goes downhill.
+// `target` and `source` are used as given (the caller downsamples). Fills transform,
+// iterations, converged and message; the caller scores the result.
+RegistrationResult align_narrower_ndt(const PointCloud& target, const PointCloud& source,
+                                      const Eigen::Isometry3d& initial, Dof dof,
+                                      const NdtConfig& config);
+
+}  // namespace scanplan

@@ -1,0 +1,85 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <optional>
+#include <string_view>
+
+#include "scanplan/core/line_segment_icp.hpp"
+#include "scanplan/core/narrower_ndt.hpp"
+#include "scanplan/core/pcl_registration.hpp"
+#include "scanplan/core/point_cloud.hpp"
+#include "scanplan/core/registration_result.hpp"
+
+namespace scanplan {
+
+// Scan matching (paper §4, DESIGN.md "Scan matching"): one entry point for our methods and
+// PCL's, so that they run on the same input and are scored the same way.
+enum class Method {
+  kNdtIcp,  // narrower NDT, then line-segment ICP (paper §4.3): the default
+  kNdt,     // narrower NDT alone (§4.2)
+  kIcp,     // line-segment ICP alone (§4.1)
+  kPclNdt,  // pcl::NormalDistributionsTransform (6 DOF only)
+  kPclIcp,  // pcl::IterativeClosestPoint (6 DOF only)
+  kPclGicp, // pcl::GeneralizedIterativeClosestPoint (6 DOF only)
+};
+
+// "ndt-icp", "ndt", "icp", "pcl-ndt", "pcl-icp", "pcl-gicp"; nullopt for anything else.
+std::optional<Method> parse_method(std::string_view name);
+std::string_view method_name(Method method);
+
+// Everything a match can be tuned by, as plain data. Lengths are for outdoor scans like the
+// paper's (tens of metres); with adapt_to_scene they shrink for shorter-range data.
+struct RegistrationConfig {
+  Dof dof = Dof::k4;  // paper §4.3: the inclination sensor fixes roll and pitch
+  // Both clouds are first thinned to one centroid per cube of this side (0: not thinned), so
+  // that every method sees the same points and the dense ground at the scanner's feet does not
+  // outweigh the walls.
+  double voxel_m = 0.25;
+  // Scales every length here (voxel, NDT cells, ICP distances, PCL settings, score and sanity
+  // distances) by min(1, scene range / reference_scene_range_m), the scene range being
+  // scene_range_m() of the target. The paper's 20/15/10 m NDT cells suit scans that see tens of
+  // metres; in a scan whose points lie mostly within a few metres (the 3DTK sample: median
+  // range 1.5 m) a 20 m cell holds the whole scene and the score has no shape.
+  bool adapt_to_scene = true;
+  double reference_scene_range_m = 12.0;
+
+  NdtConfig ndt;
+  IcpConfig icp{.source_voxel_m = 0.5};
+  PclConfig pcl;
+
+  // Eq. 2 score: each squared distance is truncated at this (see evaluate_alignment).
+  double score_max_distance_m = 1.0;
+  // The sanity check behind `converged`: a solver that stopped on its tolerances has still
+  // failed when too few source points found a target point within inlier_distance_m (the
+  // clouds do not overlap, or the match is wrong), or when the matched surfaces do not pin the
+  // pose down in every direction (AlignmentQuality::weakest_constraint below min_constraint: a
+  // corridor or a single wall, along which any position fits as well as the true one).
+  double inlier_distance_m = 0.3;
+  double min_inlier_ratio = 0.2;
+  double min_constraint = 0.01;
+  // Fewer points than this in either cloud after thinning: no match is attempted.
+  std::size_t min_points = 30;
+};
+
+// How far the scanner sees in `cloud`, whose origin is taken as the sensor: the 90th percentile
+// of the point ranges. (Not the median: a scanner whose fan sweeps the ground at its feet puts
+// half its points within a couple of metres even on an open campus.) 0 for an empty cloud.
+double scene_range_m(const PointCloud& cloud);
+
+// `config` with every length multiplied by `factor`.
+RegistrationConfig scale_lengths(const RegistrationConfig& config, double factor);
+
+// The configuration register_scans actually uses for this target: scaled when adapt_to_scene.
+RegistrationConfig adapted_config(const PointCloud& target, const RegistrationConfig& config);
+
+// Finds the transform that maps `source` into `target`, starting from `initial`. Bad input
+// (an empty cloud, too few points, a non-finite initial transform, clouds that do not overlap)
+// is not an exception: it gives converged = false with the reason in `message`, and never a
+// wrong pose marked converged as far as the sanity check can tell.
+RegistrationResult register_scans(const PointCloud& target, const PointCloud& source,
+                                  const Eigen::Isometry3d& initial,
+                                  Method method = Method::kNdtIcp,
+                                  const RegistrationConfig& config = {});
+
+}  // namespace scanplan

@@ -1,0 +1,101 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "scanplan/core/mls_map.hpp"
+#include "scanplan/core/movable_region.hpp"
+#include "scanplan/core/region_segmentation.hpp"
+#include "scanplan/core/target_region.hpp"
+#include "scanplan/core/visibility.hpp"
+
+namespace scanplan {
+
+// How the next scan point is chosen among the movable cells (paper §3.4 and beyond it).
+enum class PlannerPolicy {
+  kPaper,           // hill climbing on F from seeded random starts (paper §3.4)
+  kExhaustive,      // F at every movable cell (or every lattice_m), the best wins
+  kTravel,          // F traded against the drive there (paper §5 future work)
+  kNearestFrontier,  // the nearest movable cell next to unscanned cells (Yamauchi's frontiers)
+  kRandom,          // a seeded random movable cell where a scan gains something
+};
+
+// "paper", "exhaustive", "travel", "nearest-frontier", "random"; nothing for other names.
+std::optional<PlannerPolicy> parse_policy(std::string_view name);
+std::string_view policy_name(PlannerPolicy policy);
+
+struct PlannerConfig {
+  PlannerPolicy policy = PlannerPolicy::kPaper;
+  double alpha = 0.5;  // paper Eq. 1 weight α (§3.4); §3.5 uses 0.5
+  std::uint64_t seed = 1;
+  int hill_climb_starts = 8;  // paper §3.4: hill climbing "from several randomized initial locations"
+  // Hill climbing moves to the best of the 8 neighbours this far away while that improves F,
+  // then halves the move down to one cell: the long moves cross F's small local ripples
+  // (cell-sized noise of the discrete beams) that stop a one-cell climb early.
+  double hill_climb_step_m = 8.0;
+  // The starts are the best hill_climb_starts of this many random movable cells (0: the
+  // first hill_climb_starts random cells, as the paper has it).
+  int hill_climb_samples = 128;
+  double lattice_m = 1.0;  // exhaustive and travel: candidate spacing (one cell at most)
+  int max_candidates = 5;  // ranked list length
+  // travel: score = F − travel_cost_per_m · path length. F is in m² of map gained, so this is
+  // the gain a metre of driving must buy: 5 m²/m lets a site 40 m farther win only when it
+  // gains 200 m² more, about a fifth of a typical step's F at α = 0.5 on the campus, so
+  // the robot finishes the area around it before crossing the site, yet still goes far when
+  // nothing near is left.
+  double travel_cost_per_m = 5.0;
+  // Candidates in the ranked list lie at least this far apart, so that the operator chooses
+  // among different places rather than neighbouring cells of one.
+  double candidate_separation_m = 5.0;
+  // A scan that would gain less than this (F, in m²) is not worth making.
+  double min_gain_m2 = 1.0;
+  // Candidates and paths keep to cells whose centre is in the target region.
+  bool stay_in_target = true;
+  int threads = 0;  // OpenMP threads for the evaluations; 0: the OpenMP default
+  VisibilityConfig visibility;
+  RegionConfig regions;
+  MovableConfig movable;
+};
+
+struct Candidate {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // x, y, floor z of the scan point B
+  double f = 0;                   // Eq. 1 value
+  double gain_unscanned_m2 = 0;   // area((U∩C_B) ∪ (U∩M_B))
+  double gain_low_res_m2 = 0;     // area(M_A∩C_B)
+  double travel_m = 0;            // path length over the movable region from the robot
+  std::vector<Eigen::Vector2d> path;  // cell centres from the robot to B
+  double score = 0;  // what the policy ranked by: F (paper, exhaustive, random), F − cost·travel
+                     // (travel), −travel (nearest-frontier)
+};
+
+struct PlanInput {
+  const MlsMap& map;
+  const TargetRegion& target;
+  const std::vector<Eigen::Vector2d>& scan_points;  // where scans were taken (x, y)
+  Eigen::Vector3d robot;                            // x, y, floor z
+};
+
+struct Plan {
+  std::vector<Candidate> ranked;  // best first
+  RegionMap regions;
+  MovableRegion movable;
+  std::size_t evaluations = 0;  // F computations made
+  double plan_ms = 0;
+};
+
+// The next scan point (paper §3, steps 3-4): segments C/M/U, floods the movable region from
+// the robot, and ranks movable cells by the policy. `ranked` is empty when no cell is movable
+// or no scan would gain min_gain_m2. Deterministic for a seed, whatever the thread count.
+// Throws std::invalid_argument for a config out of range.
+Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg);
+
+// F (Eq. 1) for a scan at `b` (x, y, floor z) against the current map and scan points; fills
+// the gain fields and position of `detail` when given. For tests and tools; plan_next_scan
+// evaluates many cells far faster.
+double evaluate(const PlanInput& in, const PlannerConfig& cfg, const Eigen::Vector3d& b,
+                Candidate* detail = nullptr);
+
+}  // namespace scanplan

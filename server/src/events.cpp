@@ -1,0 +1,38 @@
+#include "events.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <ctime>
+
+#include "http/websocket_hub.hpp"
+
+namespace scanplan::server {
+
+void Events::publish(const std::string& type, nlohmann::json data) const {
+  if (!hub_) return;
+  const auto now = std::chrono::system_clock::now();
+  const std::time_t t = std::chrono::system_clock::to_time_t(now);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char at[32];
+  std::strftime(at, sizeof at, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  data["type"] = type;
+  data["at"] = at;
+  try {
+    hub_->broadcast_text(data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+  } catch (const std::exception& e) {
+    spdlog::warn("event '{}' not sent: {}", type, e.what());
+  }
+}
+
+void Events::map_chunk(std::int64_t scan_id, const std::string& draco) const {
+  if (!hub_) return;
+  try {
+    hub_->broadcast_binary(kMapChunkOp, static_cast<std::uint32_t>(scan_id), draco);
+  } catch (const std::exception& e) {
+    spdlog::warn("map chunk of scan {} not sent: {}", scan_id, e.what());
+  }
+}
+
+}  // namespace scanplan::server

@@ -1,0 +1,32 @@
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace scanplan::http {
+class WebSocketHub;
+}
+
+namespace scanplan::server {
+
+// What happens in the session, pushed to every browser on GET /api/v1/events: JSON text frames
+// {"type", "at", ...} and binary map chunks (one Draco point cloud per scan). Without a hub
+// (offline tools, tests) events go nowhere.
+class Events {
+ public:
+  explicit Events(http::WebSocketHub* hub = nullptr) : hub_(hub) {}
+
+  // Event types: scan_progress, robot_status, scan_received, map_updated, plan_done,
+  // decision, move_state.
+  void publish(const std::string& type, nlohmann::json data) const;
+  // The new points of scan `scan_id` in the map frame, Draco-encoded: binary frame op 1.
+  void map_chunk(std::int64_t scan_id, const std::string& draco) const;
+
+  static constexpr std::uint8_t kMapChunkOp = 1;
+
+ private:
+  http::WebSocketHub* hub_;
+};
+
+}  // namespace scanplan::server

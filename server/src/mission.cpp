@@ -1,0 +1,136 @@
+#include "mission.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+
+namespace scanplan::server {
+
+using nlohmann::json;
+
+Mission::Mission(ScanStore& store, DdsLink& dds, SessionStore& session, const Events& events)
+    : store_(store), dds_(dds), session_(session), events_(events) {}
+
+void Mission::record(const std::string& kind, json details) {
+  details["kind"] = kind;
+  events_.publish("mission", details);
+  try {
+    session_.append_event(kind, details.dump());
+  } catch (const std::exception& e) {
+    spdlog::error("could not record '{}' in the session: {}", kind, e.what());
+  }
+}
+
+CandidateRecord Mission::find(std::uint64_t id, std::string* robot) const {
+  const auto plan = store_.plan();
+  if (plan) {
+    for (const auto& c : plan->candidates) {
+      if (c.id == id) {
+        if (robot) *robot = plan->robot;
+        return c;
+      }
+    }
+  }
+  throw MissionError(404, "not_found",
+                     "no candidate " + std::to_string(id) +
+                         " in the current plan (plans are "
+                         "replaced after every scan: GET /api/v1/candidates)");
+}
+
+json Mission::approve(std::uint64_t id, const std::string& by) {
+  std::lock_guard lock(mutex_);
+  std::string robot;
+  const CandidateRecord c = find(id, &robot);
+  if (c.state != "proposed") {
+    throw MissionError(409, "conflict", "candidate " + std::to_string(id) + " is " + c.state);
+  }
+  if (moving_.count(robot)) {
+    throw MissionError(409, "conflict",
+                       "robot '" + robot + "' is still carrying out an approved move");
+  }
+  // Face along the last leg of the path, so the scan starts looking where the robot went.
+  double yaw_deg = 0;
+  const auto& path = c.candidate.path;
+  if (path.size() >= 2) {
+    const Eigen::Vector2d d = path.back() - path[path.size() - 2];
+    yaw_deg = rad2deg(std::atan2(d.y(), d.x()));
+  }
+  std::uint32_t command = 0;
+  try {
+    command = dds_.request_move(robot, c.candidate.position.x(), c.candidate.position.y(), yaw_deg);
+  } catch (const NoScannerError& e) {
+    throw MissionError(503, "no_robot", e.what());
+  }
+  moving_[robot] = {command, id};
+  store_.set_candidate_state(id, "moving");
+  const json out = {{"candidate", id},
+                    {"robot", robot},
+                    {"command_id", command},
+                    {"x", c.candidate.position.x()},
+                    {"y", c.candidate.position.y()},
+                    {"yaw_deg", yaw_deg},
+                    {"by", by}};
+  record("approve", out);
+  return out;
+}
+
+json Mission::reject(std::uint64_t id, const std::string& by, const std::string& reason) {
+  std::lock_guard lock(mutex_);
+  const CandidateRecord c = find(id, nullptr);
+  if (c.state != "proposed") {
+    throw MissionError(409, "conflict", "candidate " + std::to_string(id) + " is " + c.state);
+  }
+  store_.set_candidate_state(id, "rejected", reason);
+  const json out = {{"candidate", id}, {"by", by}, {"reason", reason}};
+  record("reject", out);
+  return out;
+}
+
+json Mission::cancel(std::uint64_t id, const std::string& by) {
+  std::lock_guard lock(mutex_);
+  std::string robot;
+  const CandidateRecord c = find(id, &robot);
+  const auto it = moving_.find(robot);
+  if (it == moving_.end() || it->second.candidate != id) {
+    throw MissionError(409, "conflict",
+                       "candidate " + std::to_string(id) + " is not being driven to");
+  }
+  // A move to where the robot stands supersedes the old goal: the robot stops there.
+  const auto states = store_.robot_states();
+  const auto rs = states.find(robot);
+  const Pose here = rs != states.end() ? rs->second.status.reported : Pose{};
+  try {
+    dds_.request_move(robot, here.x, here.y, rad2deg(here.yaw));
+  } catch (const NoScannerError& e) {
+    throw MissionError(503, "no_robot", e.what());
+  }
+  moving_.erase(it);
+  store_.set_candidate_state(id, "cancelled");
+  const json out = {{"candidate", id}, {"robot", robot}, {"by", by}};
+  record("cancel", out);
+  return out;
+}
+
+void Mission::on_status(const std::string& robot, const RobotStatus& status) {
+  std::lock_guard lock(mutex_);
+  const auto it = moving_.find(robot);
+  if (it == moving_.end() || status.command_id != it->second.command_id) return;
+  const std::uint64_t candidate = it->second.candidate;
+  if (status.state == "arrived") {
+    moving_.erase(it);
+    store_.set_candidate_state(candidate, "reached");
+    record("arrived", {{"candidate", candidate}, {"robot", robot}, {"message", status.message}});
+    try {
+      const std::uint32_t scan = dds_.request_scan(robot);
+      record("scan_requested", {{"robot", robot}, {"command_id", scan}, {"after", "arrival"}});
+    } catch (const std::exception& e) {
+      spdlog::error("robot '{}' arrived but the scan command failed: {}", robot, e.what());
+    }
+  } else if (status.state == "refused") {
+    moving_.erase(it);
+    store_.set_candidate_state(candidate, "refused", status.message);
+    record("refused", {{"candidate", candidate}, {"robot", robot}, {"message", status.message}});
+  }
+}
+
+}  // namespace scanplan::server

@@ -1,0 +1,56 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "dds_link.hpp"
+#include "events.hpp"
+#include "scan_store.hpp"
+#include "scanplan/core/session_store.hpp"
+
+namespace scanplan::server {
+
+// Thrown for a decision that cannot be carried out; the API turns it into a JSON error.
+class MissionError : public std::runtime_error {
+ public:
+  MissionError(int status, std::string code, const std::string& message)
+      : std::runtime_error(message), status(status), code(std::move(code)) {}
+  int status;
+  std::string code;
+};
+
+// The operator's decisions and what follows from them: nothing moves without an approval.
+// Approving a candidate sends its robot there over DDS; when the robot reports arrival, the
+// scan command follows. Every decision is recorded in the session with who made it and when.
+class Mission {
+ public:
+  Mission(ScanStore& store, DdsLink& dds, SessionStore& session, const Events& events);
+
+  nlohmann::json approve(std::uint64_t candidate, const std::string& by);
+  nlohmann::json reject(std::uint64_t candidate, const std::string& by, const std::string& reason);
+  // Stops an approved move where the robot now is.
+  nlohmann::json cancel(std::uint64_t candidate, const std::string& by);
+  // From the DDS thread.
+  void on_status(const std::string& robot, const RobotStatus& status);
+
+ private:
+  struct ActiveMove {
+    std::uint32_t command_id;
+    std::uint64_t candidate;
+  };
+  CandidateRecord find(std::uint64_t candidate, std::string* robot) const;
+  void record(const std::string& kind, nlohmann::json details);
+
+  ScanStore& store_;
+  DdsLink& dds_;
+  SessionStore& session_;
+  const Events& events_;
+  std::mutex mutex_;
+  std::map<std::string, ActiveMove> moving_;  // by robot
+};
+
+}  // namespace scanplan::server

@@ -1,0 +1,328 @@
+// Scan-point planner on the campus (issue 5): one planning step per policy on the map after
+// five scans, on 2 threads; the optimality gap of `paper` (hill climbing) against `exhaustive`
+// over 20 planning steps of a closed loop; and how well the predicted view of a scan matches
+// the cells the simulated scan then really adds. The baseline, run in the same process, is
+// the paper's way of predicting a scan (§3.4: "a ray-tracing scan in 3-D virtual space"): every
+// beam of the fan cast on its own through the MLS map, cell by cell, with the same model of
+// unknown cells and the same gap filling, so the two must agree and only the cost differs.
+// Prints one JSON line. Usage: planner_bench [WORLD.json] [STEPS]
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "scanplan/core/mls_map.hpp"
+#include "scanplan/core/scan_gain.hpp"
+#include "scanplan/core/scan_planner.hpp"
+#include "scanplan/core/simulated_scanner.hpp"
+#include "scanplan/core/visibility.hpp"
+#include "scanplan/core/world_traversability.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using namespace scanplan;
+
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// The paper's prediction, one beam at a time: each beam of each fan walks the cells under it
+// until its height inside a cell meets one of the cell's patches (unknown cells: ground at the
+// last ground height seen along the beam, solid below a cell's lowest surface, as
+// VisibilityPredictor assumes), then the returns of
+// a fan are gap-filled by insert_scan's rule. Deliberately plain: it is the reference.
+std::vector<std::uint8_t> per_beam_prediction(const MlsMap& map, const CellGrid<Region>& raster,
+                                              CellIndex sensor, double floor_z,
+                                              const VisibilityConfig& cfg) {
+  std::vector<std::uint8_t> seen(raster.values.size(), 0);
+  const double cell = map.cell_m();
+  const double sz = floor_z + cfg.sensor_height_m;
+  const Eigen::Vector2d o = map.center_of(sensor);
+  const int beams = static_cast<int>(std::floor(cfg.vertical_fov_deg / cfg.elevation_step_deg + 1e-9)) + 1;
+  const int n_az = static_cast<int>(std::lround(360.0 / cfg.azimuth_step_deg));
+  const auto& mc = map.config();
+  const auto mark = [&](CellIndex c) {
+    if (const auto off = raster.offset(c)) seen[*off] = 1;
+  };
+  struct Return {
+    double d, z;
+  };
+  std::vector<std::optional<Return>> returns(static_cast<std::size_t>(beams));
+  for (int a = 0; a < n_az; ++a) {
+    const double az = 2 * M_PI * a / n_az;
+    const Eigen::Vector2d dir(std::cos(az), std::sin(az));
+    for (int k = 0; k < beams; ++k) {
+      returns[static_cast<std::size_t>(k)].reset();
+      const double el = deg2rad(-cfg.vertical_fov_deg / 2 + k * cfg.elevation_step_deg);
+      const double t = std::tan(el);
+      double ground = floor_z;
+      // Walk the cells under the beam in 1/8-cell steps (a cell clipped by less is missed, as
+      // the sampling of a plain ray march would miss it).
+      CellIndex last{INT32_MIN, INT32_MIN};
+      for (double d = 0; d < cfg.max_range_m; d += cell / 8) {
+        const Eigen::Vector2d p = o + d * dir;
+        const CellIndex c = map.index_of(p.x(), p.y());
+        if (c == last) continue;
+        last = c;
+        // The beam's heights across this cell: entry and exit along the ray.
+        const Eigen::Vector2d lo_xy(c.x * cell, c.y * cell);
+        const double d0 = d;
+        double exit = 1e9;  // where the ray leaves the cell's square
+        for (int axis = 0; axis < 2; ++axis) {
+          if (std::abs(dir[axis]) < 1e-12) continue;
+          const double bound = dir[axis] > 0 ? lo_xy[axis] + cell : lo_xy[axis];
+          exit = std::min(exit, (bound - o[axis]) / dir[axis]);
+        }
+        const double d1 = std::max(d0, exit);
+        const double za = sz + t * d0, zb = sz + t * d1;
+        const double zlo = std::min(za, zb), zhi = std::max(za, zb);
+        const MlsCell* mls = map.cell(c);
+        std::vector<std::pair<double, double>> patches;
+        const bool hanging = mls && mls->patches[0].min_z > ground + cfg.ground_max_jump_m;
+        if (!mls || hanging) {
+          if (cfg.unknown_as_ground) patches.emplace_back(-1e9, ground);
+        } else {
+          const auto& p0 = mls->patches[0];
+          if (p0.extent() <= cfg.ground_max_extent_m && std::abs(p0.max_z - ground) <= cfg.ground_max_jump_m) {
+            ground = p0.max_z;
+          }
+        }
+        if (mls) {
+          for (const auto& p : *mls) patches.emplace_back(p.min_z, p.max_z);
+        }
+        if (!hanging && !patches.empty()) patches[0].first = -1e9;
+        bool hit = false;
+        for (const auto& [plo, phi] : patches) {
+          if (zhi < plo || zlo > phi) continue;
+          // Where the beam enters the patch.
+          double hd = d0, hz = za;
+          if (t < 0 && za > phi) {
+            hd = (phi - sz) / t;
+            hz = phi;
+          } else if (t > 0 && za < plo) {
+            hd = (plo - sz) / t;
+            hz = plo;
+          }
+          const double r = std::hypot(hd, hz - sz);
+          if (r >= cfg.min_range_m && r <= cfg.max_range_m) {
+            returns[static_cast<std::size_t>(k)] = Return{hd, hz};
+            mark(c);
+          }
+          hit = true;
+          break;
+        }
+        if (hit) break;
+        d = std::max(d, d1 - cell / 8);  // jump to the cell's exit
+      }
+    }
+    if (!mc.fill_between_beams) continue;
+    std::optional<Return> prev;
+    for (int k = 0; k < beams; ++k) {
+      const auto& r = returns[static_cast<std::size_t>(k)];
+      if (!r) continue;
+      if (prev && prev->z < sz && r->z < sz && prev->d > 0.3 && r->d > 0.3) {
+        const double len = std::abs(r->d - prev->d);
+        if (len >= cell && len <= mc.fill_max_gap_m && std::abs(r->z - prev->z) <= mc.fill_max_slope * len) {
+          const int steps = static_cast<int>(std::ceil(len / (0.5 * cell)));
+          for (int s = 1; s < steps; ++s) {
+            const double d = prev->d + (r->d - prev->d) * s / steps;
+            const Eigen::Vector2d p = o + d * dir;
+            mark(map.index_of(p.x(), p.y()));
+          }
+        }
+      }
+      prev = r;
+    }
+  }
+  return seen;
+}
+
+double iou(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b) {
+  std::size_t inter = 0, uni = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    inter += a[i] && b[i];
+    uni += a[i] || b[i];
+  }
+  return uni ? static_cast<double>(inter) / uni : 1.0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string world_file = argc > 1 ? argv[1] : SCANPLAN_SOURCE_DIR "/samples/worlds/campus.json";
+  const int loop_steps = argc > 2 ? std::stoi(argv[2]) : 20;
+  const World world = load_world(world_file);
+  const RayCaster caster(world);
+  const WorldTraversability truth(world, caster);
+  const TargetRegion target = TargetRegion::of_world(world);
+  const Eigen::Vector3d sensor(0, 0, world.scanner.mount_height_m);
+
+  // The true pose of a robot put down at (x, y) near height z: on the real surface, tilted
+  // with the ground, as the bridge would stand it.
+  const auto true_pose = [&](double x, double y, double z) {
+    const auto hit = caster.cast({x, y, z + 1.0}, {0, 0, -1}, 0.0, 2.0);
+    const double ground = hit ? z + 1.0 - hit->range : z;
+    return truth.standing_pose(x, y, ground, 0.0);
+  };
+
+  // Five scans across the middle of the campus, on open ground.
+  const std::vector<Eigen::Vector2d> first = {{80, 45}, {115, 42}, {60, 48}, {95, 100}, {130, 98}};
+  MlsMap map;
+  std::vector<Eigen::Vector2d> scan_points;
+  Pose robot;
+  for (std::size_t k = 0; k < first.size(); ++k) {
+    robot = true_pose(first[k].x(), first[k].y(), world.ground_height(first[k].x(), first[k].y()));
+    map.insert_scan(simulate_scan(caster, world.scanner, robot, k + 1), robot.isometry(), sensor);
+    scan_points.push_back(first[k]);
+  }
+
+  PlannerConfig base;
+  base.threads = 2;
+  base.visibility = VisibilityConfig::from_scanner(world.scanner);
+  const PlanInput input{map, target, scan_points, {robot.x, robot.y, robot.z}};
+
+  // One planning step per policy on the five-scan map: best of 3 (the machine is shared).
+  nlohmann::json policies = nlohmann::json::object();
+  for (const PlannerPolicy p : {PlannerPolicy::kPaper, PlannerPolicy::kExhaustive, PlannerPolicy::kTravel,
+                                PlannerPolicy::kNearestFrontier, PlannerPolicy::kRandom}) {
+    PlannerConfig cfg = base;
+    cfg.policy = p;
+    double best = 1e300;
+    Plan plan;
+    for (int r = 0; r < 3; ++r) {
+      plan = plan_next_scan(input, cfg);
+      best = std::min(best, plan.plan_ms);
+    }
+    nlohmann::json j = {{"ms", best}, {"evaluations", plan.evaluations}};
+    if (!plan.ranked.empty()) {
+      const Candidate& c = plan.ranked.front();
+      j["f"] = c.f;
+      j["xy"] = {c.position.x(), c.position.y()};
+      j["travel_m"] = c.travel_m;
+    }
+    policies[std::string(policy_name(p))] = j;
+  }
+
+  // The cost of one F evaluation: the viewshed against the per-beam baseline, same cells.
+  const RegionMap regions = segment_regions(map, target, scan_points);
+  const MovableRegion movable = movable_region(map, {robot.x, robot.y, robot.z});
+  const ScanGainEvaluator gain(map, regions, base.alpha, base.regions, base.visibility);
+  std::vector<CellIndex> sample;
+  for (std::size_t o = 0; o < movable.patch.values.size() && sample.size() < 400; o += 37) {
+    const CellIndex c = movable.patch.index_at(o);
+    const Eigen::Vector2d xy = map.center_of(c);
+    if (movable.patch.values[o] >= 0 && target.contains(xy.x(), xy.y())) sample.push_back(c);
+  }
+  const auto floor_of = [&](CellIndex c) {
+    return map.cell(c)->patches[movable.patch.values[*movable.patch.offset(c)]].mean_z;
+  };
+  auto ws = gain.workspace();
+  auto t0 = Clock::now();
+  for (const CellIndex c : sample) gain.at(c, floor_of(c), ws);
+  const double us_viewshed = ms_since(t0) * 1000 / sample.size();
+  double agreement_sum = 0;
+  const int baseline_samples = 5;
+  double ms_baseline = 0;
+  for (int k = 0; k < baseline_samples; ++k) {
+    const CellIndex c = sample[static_cast<std::size_t>(k) * sample.size() / baseline_samples];
+    t0 = Clock::now();
+    const auto ref = per_beam_prediction(map, regions.cells, c, floor_of(c), base.visibility);
+    ms_baseline += ms_since(t0);
+    std::vector<std::uint8_t> ours(regions.cells.values.size(), 0);
+    for (const auto o : gain.predictor().visible_from(c, floor_of(c), ws)) ours[o] = 1;
+    agreement_sum += iou(ours, ref);
+  }
+  const double us_baseline = ms_baseline * 1000 / baseline_samples;
+
+  // A closed loop from the five-scan map: each step plans with both `paper` (a new seed each
+  // step) and `exhaustive`, then scans at the exhaustive choice; the prediction for that scan
+  // is compared with the cells the scan then adds to the map.
+  std::vector<double> gaps, iou_new, iou_all, gain_ratio, ms_paper, ms_exhaustive;
+  double sum_f_paper = 0, sum_f_best = 0;
+  for (int step = 0; step < loop_steps; ++step) {
+    const PlanInput in{map, target, scan_points, {robot.x, robot.y, robot.z}};
+    PlannerConfig cfg = base;
+    cfg.seed = 1000 + step;
+    cfg.policy = PlannerPolicy::kPaper;
+    const Plan paper = plan_next_scan(in, cfg);
+    cfg.policy = PlannerPolicy::kExhaustive;
+    const Plan best = plan_next_scan(in, cfg);
+    if (best.ranked.empty()) break;
+    ms_paper.push_back(paper.plan_ms);
+    ms_exhaustive.push_back(best.plan_ms);
+    const double f_best = best.ranked.front().f;
+    const double f_paper = paper.ranked.empty() ? 0.0 : paper.ranked.front().f;
+    gaps.push_back((f_best - f_paper) / f_best);
+    sum_f_best += f_best;
+    sum_f_paper += f_paper;
+
+    const Candidate& b = best.ranked.front();
+    const CellIndex bc = map.index_of(b.position.x(), b.position.y());
+    const auto& grid = best.regions.cells;
+    const VisibilityPredictor predictor(map, grid, base.visibility);
+    auto pws = predictor.workspace();
+    std::vector<std::uint8_t> predicted(grid.values.size(), 0), predicted_new(grid.values.size(), 0);
+    for (const auto o : predictor.visible_from(bc, b.position.z(), pws)) {
+      predicted[o] = 1;
+      predicted_new[o] = grid.values[o] == Region::kUnscanned;
+    }
+    const Pose at = true_pose(b.position.x(), b.position.y(), b.position.z());
+    const PointCloud scan = simulate_scan(caster, world.scanner, at, 100 + step);
+    MlsMap alone;
+    alone.insert_scan(scan, at.isometry(), sensor);
+    std::vector<std::uint8_t> actual(grid.values.size(), 0), actual_new(grid.values.size(), 0);
+    std::size_t new_u = 0;
+    for (std::size_t o = 0; o < grid.values.size(); ++o) {
+      if (grid.values[o] == Region::kOutside) continue;
+      const CellIndex c = grid.index_at(o);
+      actual[o] = alone.cell(c) != nullptr;
+      actual_new[o] = actual[o] && grid.values[o] == Region::kUnscanned;
+      new_u += actual_new[o];
+    }
+    for (std::size_t o = 0; o < grid.values.size(); ++o) {
+      if (grid.values[o] == Region::kOutside) predicted[o] = predicted_new[o] = 0;
+    }
+    iou_new.push_back(iou(predicted_new, actual_new));
+    iou_all.push_back(iou(predicted, actual));
+    if (b.gain_unscanned_m2 > 0) gain_ratio.push_back(new_u * grid.cell_m * grid.cell_m / b.gain_unscanned_m2);
+    map.insert_scan(scan, at.isometry(), sensor);
+    scan_points.push_back({b.position.x(), b.position.y()});
+    robot = at;
+  }
+  const auto mean = [](const std::vector<double>& v) {
+    double s = 0;
+    for (double x : v) s += x;
+    return v.empty() ? 0.0 : s / v.size();
+  };
+  const auto max_of = [](const std::vector<double>& v) {
+    return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
+  };
+
+  const nlohmann::json out = {
+      {"bench", "planner_campus"},
+      {"map_scans", first.size()},
+      {"threads", 2},
+      {"movable_m2", movable.area_m2()},
+      {"policies", policies},
+      {"us_per_evaluation_viewshed", us_viewshed},
+      {"us_per_evaluation_per_beam_baseline", us_baseline},
+      {"evaluation_speedup", us_baseline / us_viewshed},
+      {"iou_viewshed_vs_per_beam", agreement_sum / baseline_samples},
+      {"loop_steps", gaps.size()},
+      {"paper_gap_mean", mean(gaps)},
+      {"paper_gap_max", max_of(gaps)},
+      {"paper_f_share_of_optimum", sum_f_best > 0 ? sum_f_paper / sum_f_best : 1.0},
+      {"loop_ms_paper_mean", mean(ms_paper)},
+      {"loop_ms_exhaustive_mean", mean(ms_exhaustive)},
+      {"prediction_iou_new_cells_mean", mean(iou_new)},
+      {"prediction_iou_all_cells_mean", mean(iou_all)},
+      {"actual_over_predicted_unscanned_gain_mean", mean(gain_ratio)},
+      {"final_detected_m2", segment_regions(map, target, scan_points).detected_m2()}};
+  std::printf("%s\n", out.dump().c_str());
+  return 0;
+}
