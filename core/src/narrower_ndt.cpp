@@ -4,7 +4,6 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <string>
 
@@ -65,7 +64,6 @@ class NdtProblem {
       Derivatives<N> local;
       std::array<const NdtCell*, 8> cells;
       std::array<double, 8> weights;
-      static const bool kTri = getenv("SP_TRI") != nullptr;  // TUNING
 #pragma omp for schedule(static) nowait
       for (int i = 0; i < n; ++i) {
         const Eigen::Vector3d p = T * source_[i];
@@ -80,7 +78,11 @@ class NdtProblem {
           const double m = q.dot(w);
           const double exponent = 0.5 * shape_.d2 * m;
           if (exponent > kMaxExponent) continue;
-          const double e = std::exp(-exponent) * (kTri ? weights[c] : 1.0);
+          // Trilinear weights: each point weighs one Gaussian's worth wherever it is. A plain
+          // sum over the block would pay points for sitting where more cells exist, pulling the
+          // source towards the middle of the target's coverage (metres, on the campus).
+          // The weights are held constant in the derivatives, as Magnusson does.
+          const double e = std::exp(-exponent) * weights[c];
           local.cost += shape_.d1 * e;
           if constexpr (kDerivatives) {
             // d(cost)/dθ = −d1·d2·e·(wᵀJ); the Hessian adds the curvature of the Mahalanobis
@@ -206,7 +208,6 @@ RegistrationResult align(const PointCloud& target, const PointCloud& source,
       result.message = "NDT cell sizes must be positive";
       return result;
     }
-    const auto t0 = std::chrono::steady_clock::now();  // TUNING
     const NdtGrid grid(target.points, cell, config.grid);
     if (grid.size() == 0) {
       result.message = "the target has no cell of " + std::to_string(cell) + " m with " +
@@ -225,17 +226,16 @@ RegistrationResult align(const PointCloud& target, const PointCloud& source,
                                          : std::vector<double>{0.0};
     const Eigen::Isometry3d start = result.transform;
     LevelOutcome outcome;
-    bool have = false;
-    for (const double yaw : yaws) {
+    for (std::size_t h = 0; h < yaws.size(); ++h) {
       Eigen::Isometry3d T = start;
-      T.linear() = Eigen::AngleAxisd(deg2rad(yaw), Eigen::Vector3d::UnitZ()) * start.linear();
-      LevelOutcome trial = optimise_level<N>(problem, cell, points.size(), config, T);
+      T.linear() = Eigen::AngleAxisd(deg2rad(yaws[h]), Eigen::Vector3d::UnitZ()) * start.linear();
+      const LevelOutcome trial = optimise_level<N>(problem, cell, points.size(), config, T);
       result.iterations += trial.iterations;
-      if (!have || (trial.failure.empty() && (!outcome.failure.empty() || trial.cost < outcome.cost))) {
-        trial.iterations = 0;
+      const bool better = trial.failure.empty() &&
+                          (!outcome.failure.empty() || trial.cost < outcome.cost);
+      if (h == 0 || better) {
         outcome = trial;
         result.transform = T;
-        have = true;
       }
     }
     if (!outcome.failure.empty()) {

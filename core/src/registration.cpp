@@ -88,7 +88,6 @@ double scene_range_m(const PointCloud& cloud) {
 RegistrationConfig scale_lengths(const RegistrationConfig& config, double factor) {
   RegistrationConfig c = config;
   c.voxel_m *= factor;
-  for (double& cell : c.ndt.cell_sizes_m) cell *= factor;
   c.icp.max_correspondence_m *= factor;
   c.icp.min_correspondence_m *= factor;
   c.icp.source_voxel_m *= factor;
@@ -104,12 +103,18 @@ RegistrationConfig scale_lengths(const RegistrationConfig& config, double factor
 }
 
 RegistrationConfig adapted_config(const PointCloud& target, const RegistrationConfig& config) {
-  if (!config.adapt_to_scene || !(config.reference_scene_range_m > 0)) return config;
+  if (!config.adapt_to_scene) return config;
   const double range = scene_range_m(target);
-  if (!(range > 0) || range >= config.reference_scene_range_m) return config;
+  if (!(range > 0)) return config;
   // Below a hundredth of the outdoor scale the data is something else (a table-top scan); the
   // floor keeps lengths from collapsing to nothing on a handful of points.
-  return scale_lengths(config, std::max(range / config.reference_scene_range_m, 0.01));
+  const auto factor = [range](double reference) {
+    return reference > 0 ? std::clamp(range / reference, 0.01, 1.0) : 1.0;
+  };
+  RegistrationConfig c = scale_lengths(config, factor(config.reference_scene_range_m));
+  const double cells = factor(config.paper_scene_range_m);
+  for (double& cell : c.ndt.cell_sizes_m) cell *= cells;
+  return c;
 }
 
 RegistrationResult register_scans(const PointCloud& target, const PointCloud& source,

@@ -200,26 +200,23 @@ std::vector<Scored> hill_climb(const ScanGainEvaluator& gain, const Sites& sites
   std::vector<std::int32_t> starts;
   std::vector<Scored> screened;
   if (cfg.hill_climb_samples > 0) {
-    // The starts are the best of a random sample rather than the sample's first few: the same
-    // randomised initial locations, but the climbs begin on the hills worth climbing.
+    // The starts are the best of a random sample rather than the sample's first few: the
+    // same randomised initial locations, but the climbs begin on the hills worth climbing.
+    // The sample is a lattice at a random offset, about hill_climb_samples cells on the
+    // movable region: random like the paper's starts, but spread evenly, so no part of the
+    // region is left without a start nearby.
+    const int stride = std::max(
+        1, static_cast<int>(std::lround(std::sqrt(static_cast<double>(sites.size()) / cfg.hill_climb_samples))));
+    const int ox = static_cast<int>(rng.below(static_cast<std::size_t>(stride)));
+    const int oy = static_cast<int>(rng.below(static_cast<std::size_t>(stride)));
     std::vector<std::int32_t> sample;
-    if (getenv("LATTICE")) {
-      const int stride = std::max(1, static_cast<int>(std::lround(std::sqrt(static_cast<double>(sites.size()) / cfg.hill_climb_samples))));
-      const int ox = static_cast<int>(rng.below(static_cast<std::size_t>(stride)));
-      const int oy = static_cast<int>(rng.below(static_cast<std::size_t>(stride)));
-      for (std::size_t s = 0; s < sites.size(); ++s) {
-        if (floor_mod(sites.cell[s].x - ox, stride) == 0 && floor_mod(sites.cell[s].y - oy, stride) == 0) sample.push_back(static_cast<std::int32_t>(s));
+    for (std::size_t s = 0; s < sites.size(); ++s) {
+      if (floor_mod(sites.cell[s].x - ox, stride) == 0 && floor_mod(sites.cell[s].y - oy, stride) == 0) {
+        sample.push_back(static_cast<std::int32_t>(s));
       }
-    } else {
-    std::vector<bool> drawn(sites.size(), false);
-    const std::size_t want = std::min(sites.size(), static_cast<std::size_t>(cfg.hill_climb_samples));
-    while (sample.size() < want) {
-      const std::size_t s = rng.below(sites.size());
-      if (drawn[s]) continue;
-      drawn[s] = true;
-      sample.push_back(static_cast<std::int32_t>(s));
     }
-    }
+    // A region thinner than the lattice still gets a start.
+    if (sample.empty()) sample.push_back(static_cast<std::int32_t>(rng.below(sites.size())));
     screened = evaluate_sites(gain, sites, sample, threads);
     std::vector<Scored> order = screened;
     std::stable_sort(order.begin(), order.end(),
@@ -339,6 +336,38 @@ std::vector<Scored> first_worth_scanning(const ScanGainEvaluator& gain, const Si
   return out;
 }
 
+// The floor nearest the robot within kFloorSearchCells whose top is within half a metre of
+// the robot's height (movable_region's own tolerance), as x, y, z.
+std::optional<Eigen::Vector3d> nearest_floor(const MlsMap& map, const Eigen::Vector3d& robot,
+                                             const MovableConfig& config) {
+  constexpr int kFloorSearchCells = 4;
+  const CellIndex rc = map.index_of(robot.x(), robot.y());
+  for (int r = 1; r <= kFloorSearchCells; ++r) {
+    std::optional<Eigen::Vector3d> best;
+    double best_d2 = 0;
+    for (int dy = -r; dy <= r; ++dy) {
+      for (int dx = -r; dx <= r; ++dx) {
+        if (std::max(std::abs(dx), std::abs(dy)) != r) continue;
+        const CellIndex c{rc.x + dx, rc.y + dy};
+        const MlsCell* cell = map.cell(c);
+        if (!cell) continue;
+        for (int k = 0; k < cell->size; ++k) {
+          const float z = cell->patches[k].max_z;
+          if (std::abs(z - robot.z()) >= 0.5 || !is_floor(*cell, k, config)) continue;
+          const double d2 = dx * dx + dy * dy;
+          if (!best || d2 < best_d2) {
+            const Eigen::Vector2d xy = map.center_of(c);
+            best = Eigen::Vector3d(xy.x(), xy.y(), z);
+            best_d2 = d2;
+          }
+        }
+      }
+    }
+    if (best) return best;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
@@ -352,10 +381,21 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
   };
   plan.regions = segment_regions(in.map, in.target, in.scan_points, cfg.regions);
   plan.movable = movable_region(in.map, in.robot, cfg.movable);
+  Eigen::Vector3d start = in.robot;
+  if (plan.movable.cells == 0) {
+    // movable_region looks for the robot's floor within one cell. Gap filling between a
+    // ground return and the foot of a low wall can leave a ramp of interpolated heights
+    // there, and once the robot's own scan adds the real ground those cells are too deep to
+    // be floors; the robot still stands on the ground a few cells away.
+    if (const auto near = nearest_floor(in.map, in.robot, cfg.movable)) {
+      start = *near;
+      plan.movable = movable_region(in.map, start, cfg.movable);
+    }
+  }
   if (plan.movable.cells == 0 || plan.regions.unscanned + plan.regions.low_resolution == 0) return finish();
 
   const TravelMap travel =
-      travel_map(in.map, plan.movable, in.robot, cfg.movable, cfg.stay_in_target ? &in.target : nullptr);
+      travel_map(in.map, plan.movable, start, cfg.movable, cfg.stay_in_target ? &in.target : nullptr);
   const Sites sites = collect_sites(in.map, plan.movable, travel);
   if (sites.size() == 0) return finish();
   const ScanGainEvaluator gain(in.map, plan.regions, cfg.alpha, cfg.regions, cfg.visibility);

@@ -112,7 +112,7 @@ VisibilityPredictor::VisibilityPredictor(const MlsMap& map, CellIndex raster_ori
     if (i < 0 || j < 0 || i >= dense_cols_ || j >= dense_rows_) return;
     const std::size_t o = static_cast<std::size_t>(j) * dense_cols_ + i;
     DenseCell& d = dense_[o];
-    d.n = cell.size;
+    d.n = static_cast<std::int16_t>(cell.size);
     d.lo0 = cell.patches[0].min_z;
     d.hi0 = cell.patches[0].max_z;
     d.top = cell.dem_height();
@@ -122,70 +122,133 @@ VisibilityPredictor::VisibilityPredictor(const MlsMap& map, CellIndex raster_ori
     }
     max_z_ = std::max(max_z_, d.top);
   });
+  sensor_offset_ = sensor_offset;
+  if (config.thin_object_radius_m > 0) find_thin_objects();
 
-  // Each azimuth's walk through the cells (Amanatides & Woo), from the sensor's place in its
-  // cell out to the maximum range. Every sensor stands at the same place in its cell, so one
-  // table serves every candidate.
+  // The ray tree. Rays 2^l azimuth steps apart are max_ray_spacing_m apart at reach(l);
+  // level l covers the distances from reach(l + 1) to reach(l), the finest level everything
+  // beyond. A level-l ray stands for the 2^l finest azimuths of its sector and sits at their
+  // middle, so what it sees is spread evenly to the rays it splits into. Levels stop where
+  // the azimuths no longer halve or a level would cover less than two cells.
   const int n_az = std::max(1, static_cast<int>(std::lround(360.0 / config.azimuth_step_deg)));
-  const double reach = config.max_range_m / cell_m_;  // in cells
-  ray_begin_.reserve(static_cast<std::size_t>(n_az) + 1);
-  for (int a = 0; a < n_az; ++a) {
-    ray_begin_.push_back(static_cast<std::uint32_t>(steps_.size()));
-    const double az = 2 * M_PI * a / n_az;
-    const double cx = std::cos(az), cy = std::sin(az);
-    const double inf = std::numeric_limits<double>::infinity();
-    const int sx = cx > 0 ? 1 : -1, sy = cy > 0 ? 1 : -1;
-    double t_max_x = cx > 1e-12 ? (1 - sensor_offset.x()) / cx
-                     : cx < -1e-12 ? sensor_offset.x() / -cx
-                                   : inf;
-    double t_max_y = cy > 1e-12 ? (1 - sensor_offset.y()) / cy
-                     : cy < -1e-12 ? sensor_offset.y() / -cy
-                                   : inf;
-    const double dt_x = std::abs(cx) > 1e-12 ? 1 / std::abs(cx) : inf;
-    const double dt_y = std::abs(cy) > 1e-12 ? 1 / std::abs(cy) : inf;
-    int i = 0, j = 0;
-    double t = 0;
-    while (t < reach) {
-      const double t_exit = std::min(t_max_x, t_max_y);
-      if (t_exit - t > 1e-9) {
-        Step s;
-        s.dense_delta = j * dense_cols_ + i;
-        s.di = static_cast<std::int16_t>(i);
-        s.dj = static_cast<std::int16_t>(j);
-        s.d0 = static_cast<float>(t * cell_m_);
-        s.d1 = static_cast<float>(t_exit * cell_m_);
-        s.inv_d0 = t > 0 ? 1.0f / s.d0 : std::numeric_limits<float>::infinity();
-        s.inv_d1 = 1.0f / s.d1;
-        steps_.push_back(s);
-      }
-      if (t_max_x < t_max_y) {
-        i += sx;
-        t = t_max_x;
-        t_max_x += dt_x;
-      } else {
-        j += sy;
-        t = t_max_y;
-        t_max_y += dt_y;
-      }
+  azimuths_ = n_az;
+  const double step_rad = 2 * M_PI / n_az;
+  const auto reach = [&](int l) { return config.max_ray_spacing_m / (step_rad * (1 << l)); };
+  levels_ = 0;
+  while (levels_ < 6 && n_az % (2 << levels_) == 0 && reach(levels_ + 1) >= 2 * cell_m_) ++levels_;
+  level_offset_.assign(static_cast<std::size_t>(levels_) + 1, 0);
+  for (int l = 0; l <= levels_; ++l) {
+    level_offset_[static_cast<std::size_t>(l)] = static_cast<std::uint32_t>(rays_.size());
+    const double from = l == levels_ ? 0.0 : reach(l + 1);
+    const double to = l == 0 ? config.max_range_m : reach(l);
+    for (int m = 0; m < n_az >> l; ++m) {
+      const double az = step_rad * (m * (1 << l) + ((1 << l) - 1) / 2.0);
+      Ray ray;
+      ray.dir = Eigen::Vector2f(static_cast<float>(std::cos(az)), static_cast<float>(std::sin(az)));
+      ray.walk_begin = static_cast<std::uint32_t>(steps_.size());
+      // The walk always starts at the sensor: filling between returns looks back along it.
+      walk(az, to / cell_m_, sensor_offset);
+      ray.walk_end = static_cast<std::uint32_t>(steps_.size());
+      ray.segment_begin = ray.walk_begin;
+      while (ray.segment_begin < ray.walk_end && steps_[ray.segment_begin].d0 < from) ++ray.segment_begin;
+      rays_.push_back(ray);
     }
   }
-  ray_begin_.push_back(static_cast<std::uint32_t>(steps_.size()));
+}
 
-  // The ray tree. Rays 2^l steps apart reach max_ray_spacing_m apart at `reach_l`; level l
-  // covers from reach_{l+1} to reach_l, the finest level everything beyond. Levels stop where
-  // the azimuths no longer halve or a level would cover less than two cells.
-  const double step_rad = 2 * M_PI / n_az;
-  const auto reach_at = [&](int l) { return config.max_ray_spacing_m / (step_rad * (1 << l)); };
-  levels_ = 0;
-  while (levels_ < 6 && n_az % (2 << levels_) == 0 && reach_at(levels_ + 1) >= 2 * cell_m_) ++levels_;
-  level_begin_.assign(static_cast<std::size_t>(levels_ + 1) * n_az, 0);
-  for (int l = 0; l <= levels_; ++l) {
-    const double from = l == levels_ ? 0.0 : reach_at(l + 1);
-    for (int a = 0; a < n_az; ++a) {
-      std::uint32_t k = ray_begin_[static_cast<std::size_t>(a)];
-      while (k < ray_begin_[static_cast<std::size_t>(a) + 1] && steps_[k].d0 < from) ++k;
-      level_begin_[static_cast<std::size_t>(l) * n_az + a] = k;
+void VisibilityPredictor::walk(double az, double reach_cells, const Eigen::Vector2d& offset) {
+  // Amanatides & Woo through the cells, from the sensor's place in its cell. Every sensor
+  // stands at the same place in its cell, so one walk per ray serves every candidate.
+  const double cx = std::cos(az), cy = std::sin(az);
+  const double inf = std::numeric_limits<double>::infinity();
+  const int sx = cx > 0 ? 1 : -1, sy = cy > 0 ? 1 : -1;
+  double t_max_x = cx > 1e-12 ? (1 - offset.x()) / cx : cx < -1e-12 ? offset.x() / -cx : inf;
+  double t_max_y = cy > 1e-12 ? (1 - offset.y()) / cy : cy < -1e-12 ? offset.y() / -cy : inf;
+  const double dt_x = std::abs(cx) > 1e-12 ? 1 / std::abs(cx) : inf;
+  const double dt_y = std::abs(cy) > 1e-12 ? 1 / std::abs(cy) : inf;
+  int i = 0, j = 0;
+  double t = 0;
+  while (t < reach_cells) {
+    const double t_exit = std::min(t_max_x, t_max_y);
+    if (t_exit - t > 1e-9) {
+      Step s;
+      s.dense_delta = j * dense_cols_ + i;
+      s.di = static_cast<std::int16_t>(i);
+      s.dj = static_cast<std::int16_t>(j);
+      s.d0 = static_cast<float>(t * cell_m_);
+      s.d1 = static_cast<float>(t_exit * cell_m_);
+      s.inv_d0 = t > 0 ? 1.0f / s.d0 : std::numeric_limits<float>::infinity();
+      s.inv_d1 = 1.0f / s.d1;
+      steps_.push_back(s);
     }
+    if (t_max_x < t_max_y) {
+      i += sx;
+      t = t_max_x;
+      t_max_x += dt_x;
+    } else {
+      j += sy;
+      t = t_max_y;
+      t_max_y += dt_y;
+    }
+  }
+}
+
+void VisibilityPredictor::find_thin_objects() {
+  // Standing cells: the lowest patch is deeper than any floor or kerb. Their 8-connected groups
+  // that fit in 2 × 2 cells are thin objects, centred on the group's middle: a post standing
+  // on a cell corner leaves its points in all four cells around it.
+  const float deep = static_cast<float>(2 * config_.ground_max_extent_m);
+  // A deep patch hanging above its neighbours' ground (a canopy whose ground was not seen) is
+  // not standing on anything.
+  const float jump = static_cast<float>(config_.ground_max_jump_m);
+  std::vector<std::uint8_t> standing(dense_.size(), 0);
+  for (int j = 1; j + 1 < dense_rows_; ++j) {
+    for (int i = 1; i + 1 < dense_cols_; ++i) {
+      const std::size_t o = static_cast<std::size_t>(j) * dense_cols_ + i;
+      const DenseCell& d = dense_[o];
+      if (d.n == 0 || d.hi0 - d.lo0 <= deep) continue;
+      float ground = d.lo0;
+      for (int dj = -1; dj <= 1; ++dj) {
+        for (int di = -1; di <= 1; ++di) {
+          const DenseCell& n = dense_[o + static_cast<std::ptrdiff_t>(dj) * dense_cols_ + di];
+          if (n.n > 0) ground = std::min(ground, n.lo0);
+        }
+      }
+      standing[o] = d.lo0 <= ground + jump;
+    }
+  }
+  std::vector<std::int32_t> group, open;
+  for (std::size_t o = 0; o < dense_.size(); ++o) {
+    if (standing[o] != 1) continue;
+    group.clear();
+    open.assign(1, static_cast<std::int32_t>(o));
+    standing[o] = 2;
+    int i_min = dense_cols_, i_max = -1, j_min = dense_rows_, j_max = -1;
+    while (!open.empty()) {
+      const std::int32_t c = open.back();
+      open.pop_back();
+      group.push_back(c);
+      const int i = c % dense_cols_, j = c / dense_cols_;
+      i_min = std::min(i_min, i);
+      i_max = std::max(i_max, i);
+      j_min = std::min(j_min, j);
+      j_max = std::max(j_max, j);
+      for (int dj = -1; dj <= 1; ++dj) {
+        for (int di = -1; di <= 1; ++di) {
+          const int ni = i + di, nj = j + dj;
+          if (ni < 0 || nj < 0 || ni >= dense_cols_ || nj >= dense_rows_) continue;
+          const std::size_t n = static_cast<std::size_t>(nj) * dense_cols_ + ni;
+          if (standing[n] != 1) continue;
+          standing[n] = 2;
+          open.push_back(static_cast<std::int32_t>(n));
+        }
+      }
+    }
+    if (i_max - i_min > 1 || j_max - j_min > 1 || thin_centres_.size() >= static_cast<std::size_t>(std::numeric_limits<std::int16_t>::max())) continue;
+    const float cx = static_cast<float>((i_min + i_max + 1) * 0.5 * cell_m_);
+    const float cy = static_cast<float>((j_min + j_max + 1) * 0.5 * cell_m_);
+    for (const std::int32_t c : group) dense_[static_cast<std::size_t>(c)].thin = static_cast<std::int16_t>(thin_centres_.size());
+    thin_centres_.emplace_back(cx, cy);
   }
 }
 
@@ -197,8 +260,11 @@ VisibilityPredictor::Workspace VisibilityPredictor::workspace() const {
 
 struct VisibilityPredictor::Trace {
   float sz, floor, ceiling, min_r2, max_r2, ground_extent, ground_jump, min_fill, min_clip;
+  float thin_radius;
   std::size_t base;  // the sensor's cell in the dense map
   std::int64_t i0, j0;  // the sensor's cell in the raster
+  Eigen::Vector2f sensor_xy;  // metres from the dense map's corner
+  Eigen::Vector2f dir;        // of the ray being traced
 };
 
 struct VisibilityPredictor::RayState {
@@ -220,15 +286,16 @@ void VisibilityPredictor::mark(const Trace& t, const Step& s, Workspace& ws) con
   ws.visible.push_back(static_cast<std::uint32_t>(o));
 }
 
-void VisibilityPredictor::trace(const Trace& t, int a, int level, RayState& st, Workspace& ws) const {
-  const int n_az = azimuths();
+void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st, Workspace& ws) const {
+  const Ray& ray = rays_[level_offset_[static_cast<std::size_t>(level)] + static_cast<std::size_t>(m)];
+  Trace t = tr;
+  t.dir = ray.dir;
   const float* slope = slope_.data();
   const float* inv_slope = inv_slope_.data();
   const float sz = t.sz;
-  const Step* walk = steps_.data() + ray_begin_[static_cast<std::size_t>(a)];
-  const Step* begin = steps_.data() + level_begin_[static_cast<std::size_t>(level) * n_az + a];
-  const Step* end = steps_.data() + (level == 0 ? ray_begin_[static_cast<std::size_t>(a) + 1]
-                                                : level_begin_[static_cast<std::size_t>(level - 1) * n_az + a]);
+  const Step* walk = steps_.data() + ray.walk_begin;
+  const Step* begin = steps_.data() + ray.segment_begin;
+  const Step* end = steps_.data() + ray.walk_end;
 
   // Where beam k, known to cross the patch [lo, hi] of the cell entered at d0, first meets it.
   const auto landing = [&](int k, float d0, float lo, float hi, float& d, float& z) {
@@ -303,7 +370,14 @@ void VisibilityPredictor::trace(const Trace& t, int a, int level, RayState& st, 
       lo_hi[2 * n + 1] = patches_[at][2 * p + 1];
       ++n;
     }
-    if (!hanging) lo_hi[0] = -kSolid;
+    if (!hanging) {
+      lo_hi[0] = -kSolid;
+      // A ray passing beside a thin object meets only the ground at its foot.
+      if (cell.thin >= 0) {
+        const Eigen::Vector2f rel = thin_centres_[static_cast<std::size_t>(cell.thin)] - t.sensor_xy;
+        if (std::abs(rel.x() * t.dir.y() - rel.y() * t.dir.x()) > t.thin_radius) lo_hi[1] = cell.lo0;
+      }
+    }
     bool seen = false, stopped = false;
     for (int p = 0; p < n; ++p) {
       const float lo = lo_hi[2 * p], hi = lo_hi[2 * p + 1];
@@ -383,8 +457,8 @@ void VisibilityPredictor::trace(const Trace& t, int a, int level, RayState& st, 
   // Split: the ray goes on at its azimuth, and a new one starts half-way to its neighbour
   // with everything this one has seen so far.
   RayState other = st;
-  trace(t, a, level - 1, st, ws);
-  trace(t, a + (1 << (level - 1)), level - 1, other, ws);
+  trace(t, level - 1, 2 * m, st, ws);
+  trace(t, level - 1, 2 * m + 1, other, ws);
 }
 
 const std::vector<std::uint32_t>& VisibilityPredictor::visible_from(CellIndex sensor, double floor_z,
@@ -418,6 +492,9 @@ const std::vector<std::uint32_t>& VisibilityPredictor::visible_from(CellIndex se
            static_cast<std::size_t>(sensor.x - dense_origin_.x);
   t.i0 = sensor.x - raster_origin_.x;
   t.j0 = sensor.y - raster_origin_.y;
+  t.thin_radius = static_cast<float>(config_.thin_object_radius_m);
+  t.sensor_xy = ((Eigen::Vector2d(sensor.x - dense_origin_.x, sensor.y - dense_origin_.y) + sensor_offset_) * cell_m_)
+                    .cast<float>();
 
   RayState start;
   const int words = (beams_ + 63) >> 6;
@@ -427,10 +504,9 @@ const std::vector<std::uint32_t>& VisibilityPredictor::visible_from(CellIndex se
   start.k_min = 0;
   start.k_max = beams_ - 1;
   start.ground = t.floor;
-  const int n_az = azimuths();
-  for (int a = 0; a < n_az; a += 1 << levels_) {
+  for (int m = 0; m < azimuths_ >> levels_; ++m) {
     RayState st = start;
-    trace(t, a, levels_, st, ws);
+    trace(t, levels_, m, st, ws);
   }
   return ws.visible;
 }

@@ -2,10 +2,13 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cmath>
+
 namespace scanplan::server {
 
-ScanIntake::ScanIntake(SessionStore& session, ScanStore& live, const Events& events)
-    : session_(session), live_(live), events_(events) {}
+ScanIntake::ScanIntake(SessionStore& session, ScanStore& live, const Events& events,
+                       std::optional<MapMatchConfig> matching)
+    : session_(session), live_(live), events_(events), matching_(std::move(matching)) {}
 
 ScanIntake::~ScanIntake() {
   stop();
@@ -59,6 +62,38 @@ StoredScan ScanIntake::submit(const std::string& robot, const Pose& estimated,
   return stored;
 }
 
+StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
+  if (!matching_ || live_.scan_count() == 0) return scan;
+  const MapMatch m = match_to_map(
+      live_.points_near(scan.estimated.x, scan.estimated.y, matching_->target_radius_m), cloud,
+      scan.estimated, *matching_);
+  const Pose& e = scan.estimated;
+  const Pose& p = m.placed;
+  events_.publish("match_done", {{"scan", scan.id},
+                                 {"method", m.result.method},
+                                 {"converged", m.result.converged},
+                                 {"applied", m.applied},
+                                 {"score", m.result.score},
+                                 {"rmse", m.result.rmse},
+                                 {"time_ms", m.result.time_ms},
+                                 {"message", m.result.message},
+                                 {"correction",
+                                  {{"x", p.x - e.x},
+                                   {"y", p.y - e.y},
+                                   {"z", p.z - e.z},
+                                   {"yaw_deg", rad2deg(std::remainder(p.yaw - e.yaw, 2 * M_PI))}}}});
+  if (!m.applied) {
+    spdlog::warn("scan {} stays at its reported pose: {}", scan.id, m.result.message);
+    return scan;
+  }
+  spdlog::info("scan {} matched ({}): moved {:.2f} m, {:.2f}°, score {:.1f}, {:.0f} ms", scan.id,
+               m.result.method, std::hypot(p.x - e.x, p.y - e.y),
+               rad2deg(std::remainder(p.yaw - e.yaw, 2 * M_PI)), m.result.score, m.result.time_ms);
+  scan.placed = p;
+  session_.set_placed(scan.id, p);
+  return scan;
+}
+
 void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud) {
   live_.add(scan, cloud);
   if (const auto chunk = live_.encoded_chunk(scan.id)) events_.map_chunk(scan.id, *chunk);
@@ -92,6 +127,7 @@ void ScanIntake::loop() {
       next = std::move(queue_.front());
     }
     try {
+      next.first = match(next.first, next.second);
       process(next.first, next.second);
       spdlog::info("scan {} from '{}' is in the map: {} points at ({:.2f}, {:.2f}, {:.2f})",
                    next.first.id, next.first.robot, next.first.points, next.first.placed.x,

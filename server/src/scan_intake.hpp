@@ -9,6 +9,7 @@
 
 #include "events.hpp"
 #include "scan_store.hpp"
+#include "scanplan/core/map_matcher.hpp"
 #include "scanplan/core/session_store.hpp"
 
 namespace scanplan::server {
@@ -18,7 +19,8 @@ namespace scanplan::server {
 // so neither the network thread nor the DDS thread waits on the map, the layers or Draco.
 class ScanIntake {
  public:
-  ScanIntake(SessionStore& session, ScanStore& live, const Events& events);
+  ScanIntake(SessionStore& session, ScanStore& live, const Events& events,
+             std::optional<MapMatchConfig> matching = MapMatchConfig{});
   ~ScanIntake();
   ScanIntake(const ScanIntake&) = delete;
   ScanIntake& operator=(const ScanIntake&) = delete;
@@ -38,10 +40,13 @@ class ScanIntake {
   void loop();
   // Brings one stored scan into the live map and tells the browsers.
   void process(const StoredScan& scan, const PointCloud& cloud);
+  // Matches a new scan against the map so far (paper §4) and records where it goes.
+  StoredScan match(StoredScan scan, const PointCloud& cloud);
 
   SessionStore& session_;
   ScanStore& live_;
   const Events& events_;
+  std::optional<MapMatchConfig> matching_;  // nothing: scans go where the robot says they are
   mutable std::mutex mutex_;
   std::condition_variable wake_;
   std::deque<std::pair<StoredScan, PointCloud>> queue_;

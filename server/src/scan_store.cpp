@@ -134,6 +134,17 @@ void ScanStore::set_params(const MissionParams& params) {
   refresh_derived({});
 }
 
+PointCloud ScanStore::points_near(double x, double y, double radius_m) const {
+  std::lock_guard lock(mutex_);
+  PointCloud out;
+  const Eigen::Vector2f c(static_cast<float>(x), static_cast<float>(y));
+  const float r2 = static_cast<float>(radius_m * radius_m);
+  for (const auto& p : map_.points) {
+    if ((p.head<2>() - c).squaredNorm() <= r2) out.points.push_back(p);
+  }
+  return out;
+}
+
 std::vector<StoredScan> ScanStore::scans() const {
   std::lock_guard lock(mutex_);
   return scans_;

@@ -80,6 +80,8 @@ class ScanStore {
   void add(const StoredScan& scan, const PointCloud& cloud);
 
   std::vector<StoredScan> scans() const;
+  // The map's points (map frame) within `radius_m` of (x, y) in the x-y plane.
+  PointCloud points_near(double x, double y, double radius_m) const;
   std::size_t scan_count() const;
   std::size_t point_count() const;
   Bounds3 bounds() const;

@@ -16,7 +16,6 @@
 #include <vector>
 
 #include "scanplan/core/mls_map.hpp"
-#include "scanplan/core/scan_gain.hpp"
 #include "scanplan/core/scan_planner.hpp"
 #include "scanplan/core/simulated_scanner.hpp"
 #include "scanplan/core/visibility.hpp"
@@ -208,10 +207,14 @@ int main(int argc, char** argv) {
     policies[std::string(policy_name(p))] = j;
   }
 
-  // The cost of one F evaluation: the viewshed against the per-beam baseline, same cells.
+  // The cost of one prediction: the viewshed against the per-beam baseline, from the same
+  // cells with the same model (thin objects filling their cells, which the baseline does not
+  // refine), and how often the two agree on a cell.
   const RegionMap regions = segment_regions(map, target, scan_points);
   const MovableRegion movable = movable_region(map, {robot.x, robot.y, robot.z});
-  const ScanGainEvaluator gain(map, regions, base.alpha, base.regions, base.visibility);
+  VisibilityConfig plain = base.visibility;
+  plain.thin_object_radius_m = 0;
+  const VisibilityPredictor viewshed(map, regions.cells, plain);
   std::vector<CellIndex> sample;
   for (std::size_t o = 0; o < movable.patch.values.size() && sample.size() < 400; o += 37) {
     const CellIndex c = movable.patch.index_at(o);
@@ -221,9 +224,9 @@ int main(int argc, char** argv) {
   const auto floor_of = [&](CellIndex c) {
     return map.cell(c)->patches[movable.patch.values[*movable.patch.offset(c)]].mean_z;
   };
-  auto ws = gain.workspace();
+  auto ws = viewshed.workspace();
   auto t0 = Clock::now();
-  for (const CellIndex c : sample) gain.at(c, floor_of(c), ws);
+  for (const CellIndex c : sample) viewshed.visible_from(c, floor_of(c), ws);
   const double us_viewshed = ms_since(t0) * 1000 / sample.size();
   double agreement_sum = 0;
   const int baseline_samples = 5;
@@ -231,10 +234,10 @@ int main(int argc, char** argv) {
   for (int k = 0; k < baseline_samples; ++k) {
     const CellIndex c = sample[static_cast<std::size_t>(k) * sample.size() / baseline_samples];
     t0 = Clock::now();
-    const auto ref = per_beam_prediction(map, regions.cells, c, floor_of(c), base.visibility);
+    const auto ref = per_beam_prediction(map, regions.cells, c, floor_of(c), plain);
     ms_baseline += ms_since(t0);
     std::vector<std::uint8_t> ours(regions.cells.values.size(), 0);
-    for (const auto o : gain.predictor().visible_from(c, floor_of(c), ws)) ours[o] = 1;
+    for (const auto o : viewshed.visible_from(c, floor_of(c), ws)) ours[o] = 1;
     agreement_sum += iou(ours, ref);
   }
   const double us_baseline = ms_baseline * 1000 / baseline_samples;

@@ -18,13 +18,13 @@ struct NdtConfig {
   // the lowest NDT cost goes on to the finer cells. A reported yaw off by 15° or more puts
   // the far walls metres away, outside the basin of a local optimiser; a few turned starts at
   // the coarsest (cheapest) cell size widen it. {0}: the initial guess only.
-  std::vector<double> yaw_hypotheses_deg{0.0};
+  std::vector<double> yaw_hypotheses_deg{0.0, -12.0, 12.0, -24.0, 24.0};
   // Magnusson's p_o, the share of points the score treats as outliers (Magnusson 2009 eq. 6.7;
   // PCL's default too). It shapes the score: a larger value flattens it far from a Gaussian.
   double outlier_ratio = 0.55;
-  // At each cell size the source is thinned to one centroid per cube of cell × this: a 20 m
-  // Gaussian cannot use detail finer than about a metre, and fewer points are faster.
-  double source_voxel_per_cell = 0.05;
+  // At each cell size the source is thinned to one point per cube of cell × this: a Gaussian
+  // cannot use detail much finer than a fifth of its cell, and fewer points are faster.
+  double source_voxel_per_cell = 0.2;
   NdtGridOptions grid;
   // A Newton step moves at most cell × this and turns at most max_step_rad: far from the
   // optimum the quadratic model overshoots, and the line search works from a bounded step.

@@ -49,6 +49,8 @@ class SessionStore {
   // `cloud` in the scan's own frame. Returns the new scan with its id.
   StoredScan add_scan(const std::string& robot, const Pose& estimated, const Pose& placed,
                       std::int64_t stamp_ns, const PointCloud& cloud);
+  // Records where matching placed scan `id` in the map.
+  void set_placed(std::int64_t id, const Pose& placed);
   std::vector<StoredScan> scans() const;
   std::optional<StoredScan> scan(std::int64_t id) const;
   PointCloud load_points(const StoredScan& scan) const;

@@ -42,6 +42,11 @@ struct VisibilityConfig {
   // floor, not a wall or a canopy) and within ground_max_jump_m of the height carried so far.
   double ground_max_extent_m = 0.3;
   double ground_max_jump_m = 1.0;
+  // A standing object no more than two cells across (a post, a trunk, a bollard) fills its
+  // cells in the map but is usually far thinner: it stops only the rays passing within this
+  // distance of its centre, or a 16 cm lamp post would cast the shadow of a 2 m pillar.
+  // Zero: every patch fills its cell.
+  double thin_object_radius_m = 0.3;
 
   // The scanner's geometry (fan, range, mount height); the azimuth sampling stays as it is.
   static VisibilityConfig from_scanner(const ScannerConfig& scanner);
@@ -91,7 +96,7 @@ class VisibilityPredictor {
                                                  Workspace& ws) const;
 
   int beams() const { return beams_; }
-  int azimuths() const { return static_cast<int>(ray_begin_.size()) - 1; }
+  int azimuths() const { return azimuths_; }
 
  private:
   static constexpr int kMaxBeamWords = 32;  // 2048 beams in a fan
@@ -105,11 +110,17 @@ class VisibilityPredictor {
   // in `patches_`, read only for the few cells that stop a beam.
   struct DenseCell {
     float lo0 = 0, hi0 = 0, top = 0;
-    std::int32_t n = 0;  // patches; 0 = unknown
+    std::int16_t n = 0;      // patches; 0 = unknown
+    std::int16_t thin = -1;  // index into thin_centres_ when the lowest patch is a thin object
   };
   struct Trace;      // one call's constants
   struct RayState;   // what a ray carries outward and hands to the rays it splits into
-  void trace(const Trace& t, int azimuth, int level, RayState& state, Workspace& ws) const;
+  struct Ray {
+    Eigen::Vector2f dir;
+    std::uint32_t walk_begin, segment_begin, walk_end;  // into steps_
+  };
+  void walk(double azimuth, double reach_cells, const Eigen::Vector2d& sensor_offset);
+  void trace(const Trace& t, int level, int ray, RayState& state, Workspace& ws) const;
   void mark(const Trace& t, const Step& s, Workspace& ws) const;
 
   VisibilityConfig config_;
@@ -123,6 +134,9 @@ class VisibilityPredictor {
   CellIndex sensor_min_, sensor_max_;  // where a sensor may stand
   std::vector<DenseCell> dense_;
   std::vector<std::array<float, 2 * MlsCell::kMaxPatches>> patches_;  // per dense cell: lo, hi…
+  std::vector<Eigen::Vector2f> thin_centres_;  // metres from the dense map's corner
+  Eigen::Vector2d sensor_offset_;
+  void find_thin_objects();
   float max_z_ = 0;
   CellIndex raster_origin_;
   int raster_cols_, raster_rows_;
@@ -130,14 +144,13 @@ class VisibilityPredictor {
   std::vector<float> slope_;  // tan of each beam's elevation
   std::vector<float> inv_slope_;
   float el0_, inv_el_step_;
-  // Every azimuth's walk from the sensor out to the maximum range.
+  // The ray tree: at level l the rays are 2^l azimuth steps apart and cover the distances
+  // where that spacing stays within max_ray_spacing_m, level 0 out to the maximum range. Each
+  // ray's walk runs from the sensor to the end of its level's distances.
+  int azimuths_ = 0, levels_ = 0;
+  std::vector<Ray> rays_;
+  std::vector<std::uint32_t> level_offset_;  // first ray of each level in rays_
   std::vector<Step> steps_;
-  std::vector<std::uint32_t> ray_begin_;
-  // The ray tree: at level l rays are 2^l azimuth steps apart and cover the distances where
-  // that spacing stays within max_ray_spacing_m; level_begin_[l · azimuths + a] is the first
-  // step of azimuth a's walk at that level (level 0 runs on to the walk's end).
-  int levels_ = 0;
-  std::vector<std::uint32_t> level_begin_;
 };
 
 // Cells of `raster` (same geometry, 1 = seen) a scan from `sensor_xy`, standing on a floor at

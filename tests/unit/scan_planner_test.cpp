@@ -1,0 +1,233 @@
+#include "scanplan/core/scan_planner.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "scanplan/core/simulated_scanner.hpp"
+
+namespace scanplan {
+namespace {
+
+constexpr PlannerPolicy kAllPolicies[] = {PlannerPolicy::kPaper, PlannerPolicy::kExhaustive,
+                                          PlannerPolicy::kTravel, PlannerPolicy::kNearestFrontier,
+                                          PlannerPolicy::kRandom};
+
+// A 90 m × 40 m yard scanned once from (40, 20). A 3 m wall at x = 50 from y = -5 to 34 hides
+// the east half; the way round it is its north end. Ground farther than 20 m from the scan
+// point in the west is low-resolution (M), the hidden east unscanned (U): paper Fig. 5's
+// situation, where α = 1 should look behind the wall and α = 0 should go west.
+class WallYard : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    world_ = new World(parse_world(R"({"name": "wall_yard",
+      "bounds": {"min": [0, 0], "max": [90, 40]}, "ground": {"z": 0.0},
+      "objects": [{"type": "box", "min": [50, -5, 0], "max": [50.3, 34, 3.0]}],
+      "start": [40, 20, 0]})",
+                                   "wall_yard"));
+    const RayCaster caster(*world_);
+    map_ = new MlsMap();
+    map_->insert_scan(simulate_scan(caster, world_->scanner, world_->start, 1),
+                      world_->start.isometry(), {0, 0, world_->scanner.mount_height_m});
+    target_ = new TargetRegion(TargetRegion::of_world(*world_));
+  }
+  static void TearDownTestSuite() {
+    delete target_;
+    delete map_;
+    delete world_;
+  }
+
+  PlanInput input() const { return {*map_, *target_, scan_points_, {40, 20, 0}}; }
+  static Plan plan(PlannerPolicy policy, double alpha, std::uint64_t seed = 1) {
+    PlannerConfig cfg;
+    cfg.policy = policy;
+    cfg.alpha = alpha;
+    cfg.seed = seed;
+    return plan_next_scan({*map_, *target_, scan_points_, {40, 20, 0}}, cfg);
+  }
+
+  static World* world_;
+  static MlsMap* map_;
+  static TargetRegion* target_;
+  static const std::vector<Eigen::Vector2d> scan_points_;
+};
+World* WallYard::world_ = nullptr;
+MlsMap* WallYard::map_ = nullptr;
+TargetRegion* WallYard::target_ = nullptr;
+const std::vector<Eigen::Vector2d> WallYard::scan_points_ = {{40, 20}};
+
+// Within a few metres of the wall's north end, on the side where the hidden half opens up.
+bool past_the_wall(const Candidate& c) {
+  return c.position.x() > 46 && c.position.x() < 60 && c.position.y() > 32;
+}
+
+TEST_F(WallYard, EveryPolicyFindsThePointPastTheWall) {
+  for (const PlannerPolicy p : {PlannerPolicy::kPaper, PlannerPolicy::kExhaustive,
+                                PlannerPolicy::kTravel, PlannerPolicy::kNearestFrontier}) {
+    const Plan plan = WallYard::plan(p, 0.5);
+    ASSERT_FALSE(plan.ranked.empty()) << policy_name(p);
+    const Candidate& best = plan.ranked.front();
+    EXPECT_TRUE(past_the_wall(best)) << policy_name(p) << " chose " << best.position.transpose();
+    EXPECT_GT(best.gain_unscanned_m2, 500) << policy_name(p);
+  }
+  // Random only has to choose somewhere a scan gains something.
+  const Plan random = plan(PlannerPolicy::kRandom, 0.5);
+  ASSERT_FALSE(random.ranked.empty());
+  for (const Candidate& c : random.ranked) EXPECT_GE(c.f, 1.0);
+}
+
+TEST_F(WallYard, HillClimbingReachesTheExhaustiveOptimum) {
+  const double best = plan(PlannerPolicy::kExhaustive, 0.5).ranked.front().f;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const Plan paper = plan(PlannerPolicy::kPaper, 0.5, seed);
+    EXPECT_GE(paper.ranked.front().f, 0.98 * best) << "seed " << seed;
+    EXPECT_LE(paper.ranked.front().f, best);
+  }
+}
+
+// Paper §3.4, Fig. 5/6: with α = 1 the next scan goes where the unknown is, with α = 0 where
+// the low-resolution region can be brought within 20 m.
+TEST_F(WallYard, AlphaOneExploresAlphaZeroRefinesTheLowResolutionRegion) {
+  for (const PlannerPolicy p : {PlannerPolicy::kPaper, PlannerPolicy::kExhaustive}) {
+    const Candidate explore = plan(p, 1.0).ranked.front();
+    const Candidate refine = plan(p, 0.0).ranked.front();
+    EXPECT_TRUE(past_the_wall(explore)) << explore.position.transpose();
+    EXPECT_LT(refine.position.x(), 30) << "west, among the far cells of the first scan";
+    EXPECT_GT((explore.position - refine.position).head<2>().norm(), 20);
+    EXPECT_GT(explore.gain_unscanned_m2, 2 * refine.gain_unscanned_m2);
+    EXPECT_GT(refine.gain_low_res_m2, 5 * explore.gain_low_res_m2);
+    EXPECT_DOUBLE_EQ(explore.f, explore.gain_unscanned_m2);
+    EXPECT_DOUBLE_EQ(refine.f, refine.gain_low_res_m2);
+  }
+}
+
+TEST_F(WallYard, NoCandidateIsOffTheMovableRegion) {
+  for (const PlannerPolicy p : kAllPolicies) {
+    for (const double alpha : {0.0, 0.5, 1.0}) {
+      const Plan plan = WallYard::plan(p, alpha);
+      ASSERT_FALSE(plan.ranked.empty()) << policy_name(p) << " α " << alpha;
+      for (const Candidate& c : plan.ranked) {
+        const CellIndex cell = map_->index_of(c.position.x(), c.position.y());
+        EXPECT_TRUE(plan.movable.contains(cell)) << policy_name(p) << " " << c.position.transpose();
+        EXPECT_TRUE(target_->contains(c.position.x(), c.position.y()));
+        // The path: from the robot's cell to B, cell by cell over the movable region, as long
+        // as it says.
+        ASSERT_GE(c.path.size(), 1u);
+        EXPECT_LE((c.path.front() - Eigen::Vector2d(40.5, 20.5)).norm(), 1.5);
+        EXPECT_LE((c.path.back() - c.position.head<2>()).norm(), 1e-9);
+        double length = 0;
+        for (std::size_t k = 0; k < c.path.size(); ++k) {
+          EXPECT_TRUE(plan.movable.contains(map_->index_of(c.path[k].x(), c.path[k].y())));
+          if (k == 0) continue;
+          const double step = (c.path[k] - c.path[k - 1]).norm();
+          EXPECT_LE(step, std::sqrt(2.0) + 1e-9);
+          length += step;
+        }
+        EXPECT_NEAR(length, c.travel_m, 1e-3);
+      }
+    }
+  }
+}
+
+TEST_F(WallYard, TheSameSeedGivesTheSamePlanOnAnyThreadCount) {
+  for (const PlannerPolicy p : {PlannerPolicy::kPaper, PlannerPolicy::kRandom}) {
+    PlannerConfig cfg;
+    cfg.policy = p;
+    cfg.seed = 7;
+    cfg.threads = 1;
+    const Plan one = plan_next_scan(input(), cfg);
+    cfg.threads = 2;
+    const Plan two = plan_next_scan(input(), cfg);
+    ASSERT_EQ(one.ranked.size(), two.ranked.size());
+    EXPECT_EQ(one.evaluations, two.evaluations);
+    for (std::size_t k = 0; k < one.ranked.size(); ++k) {
+      EXPECT_EQ(one.ranked[k].position, two.ranked[k].position) << policy_name(p);
+      EXPECT_EQ(one.ranked[k].f, two.ranked[k].f);
+    }
+  }
+  // Another seed draws other random cells.
+  EXPECT_NE(plan(PlannerPolicy::kRandom, 0.5, 1).ranked.front().position,
+            plan(PlannerPolicy::kRandom, 0.5, 2).ranked.front().position);
+}
+
+TEST_F(WallYard, RankedCandidatesAreDistinctPlacesBestFirst) {
+  const Plan plan = WallYard::plan(PlannerPolicy::kExhaustive, 0.5);
+  ASSERT_EQ(plan.ranked.size(), 5u);
+  for (std::size_t k = 1; k < plan.ranked.size(); ++k) {
+    EXPECT_LE(plan.ranked[k].score, plan.ranked[k - 1].score);
+    for (std::size_t j = 0; j < k; ++j) {
+      EXPECT_GE((plan.ranked[k].position - plan.ranked[j].position).head<2>().norm(), 5.0);
+    }
+  }
+  std::size_t in_target = 0;
+  for (std::size_t o = 0; o < plan.movable.patch.values.size(); ++o) {
+    const Eigen::Vector2d c = map_->center_of(plan.movable.patch.index_at(o));
+    in_target += plan.movable.patch.values[o] >= 0 && target_->contains(c.x(), c.y());
+  }
+  EXPECT_EQ(plan.evaluations, in_target) << "every movable cell in the target, once";
+}
+
+TEST_F(WallYard, TravelTradesGainForDistance) {
+  PlannerConfig cfg;
+  cfg.policy = PlannerPolicy::kTravel;
+  cfg.travel_cost_per_m = 0;
+  const Plan free_travel = plan_next_scan(input(), cfg);
+  const Plan exhaustive = plan(PlannerPolicy::kExhaustive, 0.5);
+  EXPECT_EQ(free_travel.ranked.front().position, exhaustive.ranked.front().position);
+  cfg.travel_cost_per_m = 100;  // a metre is worth more than any cell a scan could add
+  const Plan costly = plan_next_scan(input(), cfg);
+  const Candidate& near = costly.ranked.front();
+  EXPECT_LT(near.travel_m, 5.0);
+  EXPECT_NEAR(near.score, near.f - 100 * near.travel_m, 1e-6);
+}
+
+TEST_F(WallYard, EvaluateAgreesWithThePlan) {
+  const Candidate best = plan(PlannerPolicy::kExhaustive, 0.5).ranked.front();
+  PlannerConfig cfg;
+  Candidate detail;
+  EXPECT_DOUBLE_EQ(evaluate(input(), cfg, best.position, &detail), best.f);
+  EXPECT_DOUBLE_EQ(detail.gain_unscanned_m2, best.gain_unscanned_m2);
+  EXPECT_DOUBLE_EQ(detail.gain_low_res_m2, best.gain_low_res_m2);
+  EXPECT_DOUBLE_EQ(best.f, 0.5 * best.gain_unscanned_m2 + 0.5 * best.gain_low_res_m2);
+}
+
+TEST_F(WallYard, NothingLeftToScanGivesAnEmptyPlan) {
+  // A target 10 m around the scan point: all of it scan-completed.
+  const TargetRegion small = TargetRegion::rectangle({35, 15}, {45, 25});
+  PlannerConfig cfg;
+  for (const PlannerPolicy p : kAllPolicies) {
+    cfg.policy = p;
+    const Plan plan = plan_next_scan({*map_, small, scan_points_, {40, 20, 0}}, cfg);
+    EXPECT_TRUE(plan.ranked.empty()) << policy_name(p);
+    EXPECT_EQ(plan.regions.unscanned + plan.regions.low_resolution, 0u);
+  }
+  // A robot nowhere near the map has no movable region.
+  const Plan lost = plan_next_scan({*map_, *target_, scan_points_, {500, 500, 0}}, cfg);
+  EXPECT_TRUE(lost.ranked.empty());
+  EXPECT_EQ(lost.movable.cells, 0u);
+}
+
+TEST_F(WallYard, ConfigOutOfRangeIsRefused) {
+  PlannerConfig cfg;
+  cfg.alpha = 1.5;
+  EXPECT_THROW(plan_next_scan(input(), cfg), std::invalid_argument);
+  cfg = {};
+  cfg.hill_climb_starts = 0;
+  EXPECT_THROW(plan_next_scan(input(), cfg), std::invalid_argument);
+  cfg = {};
+  cfg.lattice_m = 0;
+  EXPECT_THROW(plan_next_scan(input(), cfg), std::invalid_argument);
+  cfg = {};
+  EXPECT_THROW(plan_next_scan({*map_, *target_, scan_points_, {std::nan(""), 0, 0}}, cfg),
+               std::invalid_argument);
+}
+
+TEST(PlannerPolicyNames, ParseAndPrintRoundTrip) {
+  for (const PlannerPolicy p : kAllPolicies) EXPECT_EQ(parse_policy(policy_name(p)), p);
+  EXPECT_EQ(parse_policy("nearest-frontier"), PlannerPolicy::kNearestFrontier);
+  EXPECT_FALSE(parse_policy("Paper"));
+  EXPECT_FALSE(parse_policy(""));
+}
+
+}  // namespace
+}  // namespace scanplan
