@@ -56,6 +56,8 @@ test('each scan command plays the next recording, skipping a broken file with a 
 
   session = await scanAndWait(stack, 2);
   assert.equal(session.points, recorded[0].points + recorded[1].points);
-  assert.ok(Math.abs(session.last_scan.pose.yaw_deg - 90) < 1e-9);
+  // Recorded at exact poses; matching against the first scan may only nudge it.
+  const q = session.last_scan.pose;
+  assert.ok(Math.hypot(q.x - 10, q.y + 15) < 0.05 && Math.abs(q.yaw_deg - 90) < 0.3, JSON.stringify(q));
   assert.equal(stack.bridge.exitCode, null, 'the bridge is still running');
 });
