@@ -50,14 +50,31 @@ LoopResult run_closed_loop(
   std::mt19937_64 pose_rng(config.seed);
   PlannerConfig planner = config.planner;
   double path_m = 0;
+  PointCloud map_points;  // the scans as placed, for matching the next one
   for (int scan = 1; scan <= config.max_scans; ++scan) {
     LoopStep step;
     step.scan = scan;
     step.true_pose = truth;
     const PointCloud cloud = simulate_scan(caster, world.scanner, truth,
                                            config.seed * 7919 + static_cast<std::uint64_t>(scan));
-    step.placed_pose = reported_pose(truth, world.pose_noise, pose_rng);
+    step.reported_pose = reported_pose(truth, world.pose_noise, pose_rng);
+    step.placed_pose = step.reported_pose;
+    if (config.matching && !map_points.empty()) {
+      PointCloud near;
+      const float r2 = static_cast<float>(config.matching->target_radius_m * config.matching->target_radius_m);
+      const Eigen::Vector2f c(static_cast<float>(step.reported_pose.x), static_cast<float>(step.reported_pose.y));
+      for (const auto& p : map_points.points) {
+        if ((p.head<2>() - c).squaredNorm() <= r2) near.points.push_back(p);
+      }
+      const MapMatch m = match_to_map(near, cloud, step.reported_pose, *config.matching);
+      step.match = m.result;
+      step.placed_pose = m.placed;
+    }
     pipeline.add_scan(cloud, step.placed_pose);
+    if (config.matching) {
+      const Eigen::Isometry3f T = step.placed_pose.isometry().cast<float>();
+      for (const auto& p : cloud.points) map_points.points.push_back(T * p);
+    }
 
     const RegionMap& regions = *pipeline.regions();
     step.detected_m2 = regions.detected_m2();

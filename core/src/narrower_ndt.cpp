@@ -225,11 +225,14 @@ RegistrationResult align(const PointCloud& target, const PointCloud& source,
                                          ? config.yaw_hypotheses_deg
                                          : std::vector<double>{0.0};
     const Eigen::Isometry3d start = result.transform;
+    // Each hypothesis gets a few steps only; the best of them then runs to convergence.
+    NdtConfig trial_config = config;
+    if (yaws.size() > 1) trial_config.max_iterations = config.hypothesis_iterations;
     LevelOutcome outcome;
     for (std::size_t h = 0; h < yaws.size(); ++h) {
       Eigen::Isometry3d T = start;
       T.linear() = Eigen::AngleAxisd(deg2rad(yaws[h]), Eigen::Vector3d::UnitZ()) * start.linear();
-      const LevelOutcome trial = optimise_level<N>(problem, cell, points.size(), config, T);
+      const LevelOutcome trial = optimise_level<N>(problem, cell, points.size(), trial_config, T);
       result.iterations += trial.iterations;
       const bool better = trial.failure.empty() &&
                           (!outcome.failure.empty() || trial.cost < outcome.cost);
@@ -237,6 +240,10 @@ RegistrationResult align(const PointCloud& target, const PointCloud& source,
         outcome = trial;
         result.transform = T;
       }
+    }
+    if (yaws.size() > 1 && outcome.failure.empty() && !outcome.converged) {
+      outcome = optimise_level<N>(problem, cell, points.size(), config, result.transform);
+      result.iterations += outcome.iterations;
     }
     if (!outcome.failure.empty()) {
       result.message = outcome.failure;

@@ -265,6 +265,7 @@ struct VisibilityPredictor::Trace {
   std::int64_t i0, j0;  // the sensor's cell in the raster
   Eigen::Vector2f sensor_xy;  // metres from the dense map's corner
   Eigen::Vector2f dir;        // of the ray being traced
+  float half_spacing;         // half the angle to the neighbouring rays at this level
 };
 
 struct VisibilityPredictor::RayState {
@@ -290,6 +291,7 @@ void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
   const Ray& ray = rays_[level_offset_[static_cast<std::size_t>(level)] + static_cast<std::size_t>(m)];
   Trace t = tr;
   t.dir = ray.dir;
+  t.half_spacing = static_cast<float>(0.5 * 2 * M_PI / azimuths_ * (1 << level));
   const float* slope = slope_.data();
   const float* inv_slope = inv_slope_.data();
   const float sz = t.sz;
@@ -375,7 +377,10 @@ void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
       // A ray passing beside a thin object meets only the ground at its foot.
       if (cell.thin >= 0) {
         const Eigen::Vector2f rel = thin_centres_[static_cast<std::size_t>(cell.thin)] - t.sensor_xy;
-        if (std::abs(rel.x() * t.dir.y() - rel.y() * t.dir.x()) > t.thin_radius) lo_hi[1] = cell.lo0;
+        // At least half the gap to the neighbouring rays, or an object between two rays
+        // would stop neither.
+        const float radius = std::max(t.thin_radius, s->d0 * t.half_spacing);
+        if (std::abs(rel.x() * t.dir.y() - rel.y() * t.dir.x()) > radius) lo_hi[1] = cell.lo0;
       }
     }
     bool seen = false, stopped = false;

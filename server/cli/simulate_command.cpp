@@ -19,6 +19,7 @@ struct SimulateArgs {
   double alpha = 0.5;
   int max_scans = 13;
   std::uint64_t seed = 1;
+  std::string match = "on";
 };
 
 nlohmann::json optional_json(const auto& v) {
@@ -43,6 +44,7 @@ void run_simulate(const SimulateArgs& a) {
   config.planner.seed = a.seed;
   config.max_scans = a.max_scans;
   config.seed = a.seed;
+  if (a.match == "off") config.matching.reset();
 
   std::ofstream csv(out / "coverage.csv");
   if (!csv) throw std::runtime_error("cannot write " + (out / "coverage.csv").string());
@@ -74,6 +76,7 @@ void run_simulate(const SimulateArgs& a) {
       {"policy", a.policy},
       {"alpha", a.alpha},
       {"seed", a.seed},
+      {"match", a.match},
       {"scans", r.steps.size()},
       {"detected_m2", last.detected_m2},
       {"completed_m2", last.completed_m2},
@@ -103,6 +106,9 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--alpha", args->alpha, "weight α of Eq. 1 (paper §3.4)")->capture_default_str();
   cmd->add_option("--max-scans", args->max_scans, "scans at most")->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed for noise and the planner")->capture_default_str();
+  cmd->add_option("--match", args->match, "scan matching of each scan against the map (on|off)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"on", "off"}));
   cmd->add_option("--out", args->out, "output folder (coverage.csv, step_NN.png, summary.json)")
       ->required();
   cmd->callback([args] { run_simulate(*args); });

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -215,27 +216,31 @@ RegistrationResult run_method(const std::string& name, const Pair& p,
   return register_scans(p.target, p.source, p.initial, *parse_method(name), c);
 }
 
+// Runs every method on every pair, pair by pair, so that a change in the load of this shared
+// machine falls on all methods alike.
 nlohmann::json evaluate_set(const std::vector<Pair>& pairs, const std::vector<std::string>& methods,
                             bool verbose, std::map<std::string, double>& median_ms) {
-  nlohmann::json out = nlohmann::json::object();
-  std::vector<RegistrationResult> pcl_ndt;
-  for (const auto& name : methods) {
+  struct Tally {
     int success = 0, converged = 0, false_converged = 0;
     std::vector<double> ms, err_cm, err_deg;
-    for (std::size_t i = 0; i < pairs.size(); ++i) {
-      const Pair& p = pairs[i];
-      const RegistrationResult r =
-          run_method(name, p, pcl_ndt.size() == pairs.size() ? &pcl_ndt[i] : nullptr);
-      if (name == "pcl-ndt") pcl_ndt.push_back(r);
+  };
+  std::map<std::string, Tally> tally;
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const Pair& p = pairs[i];
+    std::optional<RegistrationResult> pcl_ndt;
+    for (const auto& name : methods) {
+      const RegistrationResult r = run_method(name, p, pcl_ndt ? &*pcl_ndt : nullptr);
+      if (name == "pcl-ndt") pcl_ndt = r;
       const Errors e = error_of(r.transform, p.truth);
       const bool ok = e.metres < kSuccessM && e.degrees < kSuccessDeg;
-      success += ok;
-      converged += r.converged;
-      false_converged += r.converged && !ok;
-      ms.push_back(r.time_ms);
+      Tally& t = tally[name];
+      t.success += ok;
+      t.converged += r.converged;
+      t.false_converged += r.converged && !ok;
+      t.ms.push_back(r.time_ms);
       if (ok) {
-        err_cm.push_back(100 * e.metres);
-        err_deg.push_back(e.degrees);
+        t.err_cm.push_back(100 * e.metres);
+        t.err_deg.push_back(e.degrees);
       }
       if (verbose) {
         const Errors start = error_of(p.initial, p.truth);
@@ -247,16 +252,22 @@ nlohmann::json evaluate_set(const std::vector<Pair>& pairs, const std::vector<st
                      r.message.c_str());
       }
     }
-    const double n = static_cast<double>(pairs.size());
-    median_ms[name] = median(ms);
-    out[name] = {{"success_rate", success / n},
-                 {"converged_rate", converged / n},
-                 {"converged_but_wrong", false_converged},
-                 {"median_ms", median(ms)},
-                 {"median_error_cm", median(err_cm)},
-                 {"median_error_deg", median(err_deg)}};
-    std::fprintf(stderr, "  %-16s success %5.1f%%  converged %5.1f%%  converged-but-wrong %2d  %7.1f ms\n",
-                 name.c_str(), 100 * success / n, 100 * converged / n, false_converged, median(ms));
+  }
+  nlohmann::json out = nlohmann::json::object();
+  const double n = static_cast<double>(pairs.size());
+  for (const auto& name : methods) {
+    const Tally& t = tally[name];
+    median_ms[name] = median(t.ms);
+    out[name] = {{"success_rate", t.success / n},
+                 {"converged_rate", t.converged / n},
+                 {"converged_but_wrong", t.false_converged},
+                 {"median_ms", median(t.ms)},
+                 {"median_error_cm", median(t.err_cm)},
+                 {"median_error_deg", median(t.err_deg)}};
+    std::fprintf(stderr,
+                 "  %-16s success %5.1f%%  converged %5.1f%%  converged-but-wrong %2d  %7.1f ms\n",
+                 name.c_str(), 100 * t.success / n, 100 * t.converged / n, t.false_converged,
+                 median(t.ms));
   }
   return out;
 }

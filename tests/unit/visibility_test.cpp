@@ -57,37 +57,44 @@ TEST(Visibility, WallHidesTheGroundBehindIt) {
 TEST(Visibility, ThinObjectsCastNarrowShadows) {
   MlsMap map;
   map.insert(slab(0, 60, 0, 40, 0.0f));
-  map.insert(column(25, 26, 10, 11, 0.0f, 5.0f));  // a post, alone in its cell
-  const auto g = predict_visible(map, raster(60, 40), {20.5, 10.5}, 0.0, {});
-  EXPECT_FALSE(seen(g, 35, 10)) << "straight behind the post";
-  EXPECT_TRUE(seen(g, 35, 12)) << "6° off the post's line: a 0.6 m post hides 3.4° either side";
+  map.insert(column(20, 21, 20, 21, 0.0f, 5.0f));  // a post, alone in its cell, 10 m away
+  const auto hidden_at_30m = [&](const VisibilityConfig& cfg) {
+    const auto g = predict_visible(map, raster(60, 40), {10.5, 20.5}, 0.0, cfg);
+    int hidden = 0;
+    for (int y = 10; y < 31; ++y) hidden += !seen(g, 40, y);
+    return hidden;
+  };
   VisibilityConfig blocky;
   blocky.thin_object_radius_m = 0;
-  const auto b = predict_visible(map, raster(60, 40), {20.5, 10.5}, 0.0, blocky);
-  EXPECT_FALSE(seen(b, 35, 10));
-  EXPECT_FALSE(seen(b, 35, 12)) << "the post filling its cell hides 7° either side";
+  const int thin = hidden_at_30m({}), full = hidden_at_30m(blocky);
+  EXPECT_GE(thin, 1) << "straight behind the post";
+  EXPECT_LT(thin, full) << "a 0.6 m post hides less than one filling its 1 m cell";
+  EXPECT_LE(full, 6);
 }
 
 // Paper §3.1, Fig. 2-3: the MLS map keeps the ground under a canopy and the canopy over it.
+// Here the sensor stands under a wide roof 3 to 3.5 m up; 25 m away a 5 m wall hides the foot
+// of a 15 m building, whose face can only be seen by beams rising over the wall, which the
+// roof stops.
 TEST(Visibility, CanopyBlocksTheSkyButNotTheGroundBeneath) {
   MlsMap with_roof, without_roof;
   for (MlsMap* m : {&with_roof, &without_roof}) {
     m->insert(slab(0, 80, 0, 20, 0.0f));
-    // A deck 15 m up at x 50..52, over open ground.
-    m->insert(slab(50, 52, 8, 13, 15.0f));
-    m->insert(slab(50, 52, 8, 13, 15.2f));
+    m->insert(column(45, 46, 0, 20, 0.0f, 5.0f));   // the wall
+    m->insert(column(50, 53, 0, 20, 0.0f, 15.0f));  // the building
   }
-  // A canopy 3 to 3.5 m up over the sensor, 11 m × 11 m.
-  for (float z : {3.0f, 3.2f, 3.5f}) with_roof.insert(slab(15, 26, 5, 16, z));
+  for (float z : {3.0f, 3.2f, 3.5f}) with_roof.insert(slab(5, 36, 0, 20, z));
   ASSERT_EQ(with_roof.cell({20, 10})->size, 2) << "ground and canopy are two surfaces";
 
   const auto open = predict_visible(without_roof, raster(80, 20), {20.5, 10.5}, 0.0, {});
-  EXPECT_TRUE(seen(open, 50, 10)) << "the deck, 30 m away and 14 m above the sensor";
+  EXPECT_TRUE(seen(open, 50, 10)) << "the building's face, over the wall";
+  EXPECT_FALSE(seen(open, 48, 10)) << "the ground between wall and building";
   const auto under = predict_visible(with_roof, raster(80, 20), {20.5, 10.5}, 0.0, {});
-  EXPECT_TRUE(seen(under, 16, 6)) << "the canopy, seen from below";
-  EXPECT_TRUE(seen(under, 23, 12)) << "the ground under the canopy";
-  EXPECT_TRUE(seen(under, 35, 10)) << "the ground beyond the canopy, under it";
-  EXPECT_FALSE(seen(under, 50, 10)) << "the canopy stops the beams rising to the deck";
+  EXPECT_TRUE(seen(under, 30, 15)) << "the canopy, seen from below";
+  EXPECT_TRUE(seen(under, 25, 12)) << "the ground under the canopy";
+  EXPECT_TRUE(seen(under, 40, 10)) << "the ground beyond the canopy, seen under its edge";
+  EXPECT_TRUE(seen(under, 45, 10)) << "the wall";
+  EXPECT_FALSE(seen(under, 50, 10)) << "the canopy stops the beams that would rise over the wall";
 }
 
 // Rings of a flat-ground scan from 1 m up with 0.5° beams: returns at 28.6 m, 38.2 m and
@@ -110,7 +117,7 @@ TEST(Visibility, UnknownCellsAreGroundUpToWhereTheFillingStops) {
   };
   EXPECT_GT(share(g, 15, 37), 0.97);
   EXPECT_LT(share(g, 42, 54), 0.05) << "between the rings nothing is filled";
-  EXPECT_GT(share(g, 56.5, 58.5), 0.5) << "the 57 m ring";
+  EXPECT_GT(share(g, 56.5, 58.5), 0.3) << "the 57 m ring";
 
   VisibilityConfig empty;
   empty.unknown_as_ground = false;

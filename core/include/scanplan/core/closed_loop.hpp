@@ -5,6 +5,7 @@
 #include <optional>
 #include <vector>
 
+#include "scanplan/core/map_matcher.hpp"
 #include "scanplan/core/mapping_pipeline.hpp"
 #include "scanplan/core/scan_planner.hpp"
 #include "scanplan/core/world.hpp"
@@ -18,13 +19,18 @@ struct ClosedLoopConfig {
   std::uint64_t seed = 1;
   // Stop once this share of the reachable ground is scan-completed (100: never early).
   double stop_at_coverage_pct = 100.0;
+  // Scan matching of each new scan against the map so far (paper §4); nothing: scans are placed
+  // at the reported pose.
+  std::optional<MapMatchConfig> matching = MapMatchConfig{};
 };
 
 // One scan of the loop and the decision taken after it.
 struct LoopStep {
   int scan = 0;                       // 1-based
   Pose true_pose;                     // where the robot really scanned
-  Pose placed_pose;                   // where the map put the scan (reported pose; matched when on)
+  Pose reported_pose;                 // what the robot's pose sensors said
+  Pose placed_pose;                   // where the map put the scan (matched when matching is on)
+  std::optional<RegistrationResult> match;
   double detected_m2 = 0;             // C ∪ M, the paper's detection area
   double completed_m2 = 0;            // C
   double coverage_pct = 0;            // reachable ground cells of the target region that are in C

@@ -19,6 +19,7 @@ struct NdtConfig {
   // the far walls metres away, outside the basin of a local optimiser; a few turned starts at
   // the coarsest (cheapest) cell size widen it. {0}: the initial guess only.
   std::vector<double> yaw_hypotheses_deg{0.0, -12.0, 12.0, -24.0, 24.0};
+  int hypothesis_iterations = 8;  // Newton steps each hypothesis gets before the best goes on
   // Magnusson's p_o, the share of points the score treats as outliers (Magnusson 2009 eq. 6.7;
   // PCL's default too). It shapes the score: a larger value flattens it far from a Gaussian.
   double outlier_ratio = 0.55;

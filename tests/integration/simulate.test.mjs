@@ -1,0 +1,42 @@
+// `scanplan simulate`: the closed loop without DDS writes coverage.csv, a top view per step and a
+// JSON summary (DESIGN.md "CLI").
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawnSync } from 'node:child_process';
+import { mkdtempSync, readFileSync, existsSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { requireEnv } from '../support/stack.mjs';
+
+test('simulate on the tree-row world', { timeout: 120000 }, () => {
+  const out = mkdtempSync(join(tmpdir(), 'scanplan-sim-'));
+  try {
+    const run = spawnSync(requireEnv('SCANPLAN_CLI'), ['simulate', '--world',
+      join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples/worlds/tree_row.json'), '--policy', 'paper',
+      '--alpha', '0.5', '--max-scans', '4', '--seed', '3', '--out', out], { encoding: 'utf8' });
+    assert.equal(run.status, 0, run.stderr);
+    const summary = JSON.parse(run.stdout);
+    assert.equal(summary.world, 'tree_row');
+    assert.ok(summary.scans >= 2 && summary.scans <= 4, JSON.stringify(summary));
+    const rows = readFileSync(join(out, 'coverage.csv'), 'utf8').trim().split('\n');
+    assert.equal(rows[0], 'scan,x,y,detected_m2,completed_m2,coverage_pct,path_m,plan_ms');
+    assert.equal(rows.length, summary.scans + 1);
+    const cov = rows.slice(1).map((r) => r.split(',').map(Number));
+    for (let i = 1; i < cov.length; i++) {
+      assert.ok(cov[i][3] >= cov[i - 1][3], 'the detected area never shrinks');
+      assert.ok(cov[i][6] > cov[i - 1][6], 'the robot drove between scans');
+    }
+    assert.ok(cov.at(-1)[5] > 60, `coverage ${cov.at(-1)[5]} %`);
+    assert.ok(Math.abs(summary.coverage_pct - cov.at(-1)[5]) < 0.01);
+    for (let i = 1; i <= summary.scans; i++) {
+      assert.ok(existsSync(join(out, `step_${String(i).padStart(2, '0')}.png`)));
+    }
+    const bad = spawnSync(requireEnv('SCANPLAN_CLI'), ['simulate', '--world',
+      join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples/worlds/tree_row.json'), '--policy', 'teleport',
+      '--out', out], { encoding: 'utf8' });
+    assert.notEqual(bad.status, 0);
+    assert.match(bad.stderr, /--policy must be paper, exhaustive, travel, nearest-frontier or random/);
+  } finally {
+    rmSync(out, { recursive: true, force: true });
+  }
+});
