@@ -40,7 +40,8 @@ bool surface_normal(const detail::PointKdTree& tree, const Eigen::Vector3f& q, f
 
 AlignmentQuality evaluate_alignment(const PointCloud& target, const PointCloud& source,
                                     const Eigen::Isometry3d& source_to_target, Dof dof,
-                                    double score_max_distance_m, double inlier_distance_m) {
+                                    double score_max_distance_m, double inlier_distance_m,
+                                    bool with_constraint) {
   AlignmentQuality q;
   q.points = source.size();
   if (target.empty() || source.empty()) return q;
@@ -63,7 +64,9 @@ AlignmentQuality evaluate_alignment(const PointCloud& target, const PointCloud& 
       ++q.inliers;
       inlier_sum += d2;
       Eigen::Vector3d n;
-      if (surface_normal(tree, moved, normal_sq, n)) planar.emplace_back(moved.cast<double>(), n);
+      if (with_constraint && surface_normal(tree, moved, normal_sq, n)) {
+        planar.emplace_back(moved.cast<double>(), n);
+      }
     }
   }
   q.inlier_ratio = static_cast<double>(q.inliers) / static_cast<double>(q.points);

@@ -13,9 +13,11 @@ inline float fast_atan(float x) {
   // ±inf becomes 0 here and comes out as ±π/2, which the straight-down beam relies on.
   const float z = invert ? 1.0f / ax : ax;
   const float z2 = z * z;
-  float r = z * (0.99997726f +
-                 z2 * (-0.33262347f +
-                       z2 * (0.19354346f + z2 * (-0.11643287f + z2 * (0.05265332f + z2 * -0.01172120f)))));
+  float r =
+      z *
+      (0.99997726f +
+       z2 * (-0.33262347f +
+             z2 * (0.19354346f + z2 * (-0.11643287f + z2 * (0.05265332f + z2 * -0.01172120f)))));
   if (invert) r = 1.57079632679f - r;
   return std::copysign(r, x);
 }

@@ -5,6 +5,7 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,13 @@
 
 namespace scanplan {
 namespace {
+
+// "1.25 m": lengths in messages, to three significant digits.
+std::string metres(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g m", v);
+  return buf;
+}
 
 using detail::Mat;
 using detail::Vec;
@@ -54,9 +62,8 @@ SegmentFoot closest_on_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& 
 
 template <int N>
 NormalEquations<N> linearise(const detail::PointKdTree& tree,
-                             const std::vector<Eigen::Vector3f>& source,
-                             const Eigen::Isometry3d& T, double max_distance, double kernel,
-                             int threads) {
+                             const std::vector<Eigen::Vector3f>& source, const Eigen::Isometry3d& T,
+                             double max_distance, double kernel, int threads) {
   const double kernel_sq = kernel * kernel;
   NormalEquations<N> total;
   const float max_sq = static_cast<float>(max_distance * max_distance);
@@ -72,9 +79,9 @@ NormalEquations<N> linearise(const detail::PointKdTree& tree,
       const int found = tree.nearest<2>(p.cast<float>(), max_sq, index, sq);
       if (found == 0) continue;
       const Eigen::Vector3d a = tree.point(index[0]).cast<double>();
-      const SegmentFoot foot =
-          found == 2 ? closest_on_segment(p, a, tree.point(index[1]).cast<double>())
-                     : SegmentFoot{a, Eigen::Vector3d::Zero(), false};
+      const SegmentFoot foot = found == 2
+                                   ? closest_on_segment(p, a, tree.point(index[1]).cast<double>())
+                                   : SegmentFoot{a, Eigen::Vector3d::Zero(), false};
       const Eigen::Vector3d r = p - foot.point;
       const Eigen::Matrix<double, 3, N> J = detail::point_jacobian<N>(p);
       // Geman-McClure: near-zero weight for residuals well beyond the kernel scale. Parts seen
@@ -106,9 +113,8 @@ RegistrationResult align(const PointCloud& target, const PointCloud& source,
   RegistrationResult result;
   result.method = "icp";
   result.transform = initial;
-  const PointCloud thinned = config.source_voxel_m > 0
-                                 ? voxel_downsample(source, config.source_voxel_m)
-                                 : PointCloud{};
+  const PointCloud thinned =
+      config.source_voxel_m > 0 ? voxel_downsample(source, config.source_voxel_m) : PointCloud{};
   const std::vector<Eigen::Vector3f>& points =
       config.source_voxel_m > 0 ? thinned.points : source.points;
   if (target.size() < 2 || points.empty()) {
@@ -126,8 +132,9 @@ RegistrationResult align(const PointCloud& target, const PointCloud& source,
                      config.kernel_scale_per_distance * distance, threads);
     if (eq.matches < std::max(config.min_correspondences, N)) {
       result.message = "only " + std::to_string(eq.matches) + " of " +
-                       std::to_string(points.size()) + " source points have a target point within " +
-                       std::to_string(distance) + " m: the clouds do not overlap from this start";
+                       std::to_string(points.size()) +
+                       " source points have a target point within " + metres(distance) +
+                       ": the clouds do not overlap from this start";
       return result;
     }
     // A whisper of damping keeps the solve defined when the scene leaves a direction
@@ -151,12 +158,18 @@ RegistrationResult align(const PointCloud& target, const PointCloud& source,
       result.converged = true;
       return result;
     }
-    const double next_distance = std::max(floor_distance, distance * config.shrink);
+    // The rejection distance (and with it the kernel) narrows only once the match has settled
+    // at the current one: narrowed early, it would cut off the very partners that still have
+    // to pull the scan in from an initial error of tens of centimetres.
+    const bool settled =
+        moved < 10 * config.translation_tolerance_m && turned < 10 * config.rotation_tolerance_rad;
+    const double next_distance =
+        settled || flat_error ? std::max(floor_distance, distance * config.shrink) : distance;
     previous_error = next_distance == distance ? error : -1;
     distance = next_distance;
   }
-  result.message = "ICP did not converge within " + std::to_string(config.max_iterations) +
-                   " iterations";
+  result.message =
+      "ICP did not converge within " + std::to_string(config.max_iterations) + " iterations";
   return result;
 }
 

@@ -5,6 +5,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "pose_increment.hpp"
@@ -13,6 +14,13 @@
 
 namespace scanplan {
 namespace {
+
+// "1.25 m": lengths in messages, to three significant digits.
+std::string metres(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g m", v);
+  return buf;
+}
 
 using detail::Mat;
 using detail::Vec;
@@ -90,8 +98,8 @@ class NdtProblem {
             const double k = -shape_.d1 * shape_.d2 * e;
             const Eigen::Matrix<double, 1, N> a = w.transpose() * J;
             local.gradient += k * a.transpose();
-            Mat<N> h = J.transpose() * cells[c]->inverse_covariance * J -
-                       shape_.d2 * a.transpose() * a;
+            Mat<N> h =
+                J.transpose() * cells[c]->inverse_covariance * J - shape_.d2 * a.transpose() * a;
             h.template bottomRightCorner<N - 3, N - 3>() +=
                 detail::contracted_point_hessian<N>(p, w);
             local.hessian += k * h;
@@ -134,7 +142,7 @@ Vec<N> clamp_step(Vec<N> step, double max_translation, double max_rotation) {
 struct LevelOutcome {
   int iterations = 0;
   bool converged = false;
-  double cost = 0;  // at the final transform
+  double cost = 0;      // at the final transform
   std::string failure;  // empty unless the level could not run
 };
 
@@ -147,8 +155,8 @@ LevelOutcome optimise_level(const NdtProblem<N>& problem, double cell_m, std::si
   for (; out.iterations < config.max_iterations; ++out.iterations) {
     if (static_cast<std::size_t>(d.matched) < min_matched) {
       out.failure = "only " + std::to_string(d.matched) + " of " + std::to_string(points) +
-                    " source points lie near a target Gaussian at cell size " +
-                    std::to_string(cell_m) + " m: the clouds do not overlap from this start";
+                    " source points lie near a target Gaussian at cell size " + metres(cell_m) +
+                    ": the clouds do not overlap from this start";
       return out;
     }
     const Vec<N> step = clamp_step<N>(newton_direction<N>(d.hessian, d.gradient),
@@ -210,7 +218,7 @@ RegistrationResult align(const PointCloud& target, const PointCloud& source,
     }
     const NdtGrid grid(target.points, cell, config.grid);
     if (grid.size() == 0) {
-      result.message = "the target has no cell of " + std::to_string(cell) + " m with " +
+      result.message = "the target has no cell of " + metres(cell) + " with " +
                        std::to_string(config.grid.min_points_per_cell) + " points or more";
       return result;
     }
@@ -234,8 +242,8 @@ RegistrationResult align(const PointCloud& target, const PointCloud& source,
       T.linear() = Eigen::AngleAxisd(deg2rad(yaws[h]), Eigen::Vector3d::UnitZ()) * start.linear();
       const LevelOutcome trial = optimise_level<N>(problem, cell, points.size(), trial_config, T);
       result.iterations += trial.iterations;
-      const bool better = trial.failure.empty() &&
-                          (!outcome.failure.empty() || trial.cost < outcome.cost);
+      const bool better =
+          trial.failure.empty() && (!outcome.failure.empty() || trial.cost < outcome.cost);
       if (h == 0 || better) {
         outcome = trial;
         result.transform = T;
@@ -253,7 +261,7 @@ RegistrationResult align(const PointCloud& target, const PointCloud& source,
     result.converged = outcome.converged;
     if (!outcome.converged && level + 1 == config.cell_sizes_m.size()) {
       result.message = "NDT did not settle within " + std::to_string(config.max_iterations) +
-                       " iterations at cell size " + std::to_string(cell) + " m";
+                       " iterations at cell size " + metres(cell);
     }
   }
   return result;

@@ -66,8 +66,8 @@ NdtGrid::NdtGrid(const std::vector<Eigen::Vector3f>& points, double cell_m,
         lambda = lambda.cwiseMax(floor_value);
         NdtCell cell;
         cell.mean = origin + mean;
-        cell.inverse_covariance =
-            eig.eigenvectors() * lambda.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
+        cell.inverse_covariance = eig.eigenvectors() * lambda.cwiseInverse().asDiagonal() *
+                                  eig.eigenvectors().transpose();
         cell.count = static_cast<std::uint32_t>(end - begin);
         cells_.push_back(cell);
         keys.push_back(keyed[begin].first);
@@ -113,7 +113,7 @@ const NdtCell* NdtGrid::cell_at(const Eigen::Vector3d& p) const {
 }
 
 int NdtGrid::neighbourhood(const Eigen::Vector3d& p, std::array<const NdtCell*, 8>& out,
-                          std::array<double, 8>& weight) const {
+                           std::array<double, 8>& weight) const {
   // Shifting by half a cell makes floor() give the lower corner of the 2×2×2 block whose
   // centres surround p.
   const Eigen::Vector3d shifted = p - Eigen::Vector3d::Constant(0.5 * cell_m_);
@@ -126,7 +126,8 @@ int NdtGrid::neighbourhood(const Eigen::Vector3d& p, std::array<const NdtCell*, 
     for (int dy = 0; dy < 2; ++dy) {
       for (int dx = 0; dx < 2; ++dx) {
         if (const NdtCell* cell = find(c[0] + dx, c[1] + dy, c[2] + dz)) {
-          weight[n] = (dx ? f.x() : 1 - f.x()) * (dy ? f.y() : 1 - f.y()) * (dz ? f.z() : 1 - f.z());
+          weight[n] =
+              (dx ? f.x() : 1 - f.x()) * (dy ? f.y() : 1 - f.y()) * (dz ? f.z() : 1 - f.z());
           out[n++] = cell;
         }
       }

@@ -74,7 +74,7 @@ RegistrationResult align_pcl(const PointCloud& target, const PointCloud& source,
     result = run(icp, target, source, initial);
   } else {
     Counted<pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ>> gicp;
-    gicp.setMaxCorrespondenceDistance(config.icp_max_correspondence_m);
+    gicp.setMaxCorrespondenceDistance(config.gicp_max_correspondence_m);
     gicp.setMaximumIterations(config.max_iterations);
     gicp.setTransformationEpsilon(config.transformation_epsilon);
     gicp.setEuclideanFitnessEpsilon(config.euclidean_fitness_epsilon);

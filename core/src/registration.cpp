@@ -95,6 +95,7 @@ RegistrationConfig scale_lengths(const RegistrationConfig& config, double factor
   c.pcl.ndt_resolution_m *= factor;
   c.pcl.ndt_step_size_m *= factor;
   c.pcl.icp_max_correspondence_m *= factor;
+  c.pcl.gicp_max_correspondence_m *= factor;
   c.score_max_distance_m *= factor;
   c.inlier_distance_m *= factor;
   // NDT's tolerances and step bounds are already relative to the cell size, and PCL's
@@ -143,7 +144,8 @@ RegistrationResult register_scans(const PointCloud& target, const PointCloud& so
   r.method = std::string(method_name(method));
 
   const AlignmentQuality q =
-      evaluate_alignment(t, s, r.transform, c.dof, c.score_max_distance_m, c.inlier_distance_m);
+      evaluate_alignment(t, s, r.transform, c.dof, c.score_max_distance_m, c.inlier_distance_m,
+                         /*with_constraint=*/r.converged);
   r.score = q.score;
   r.rmse = q.rmse;
   r.inlier_ratio = q.inlier_ratio;
@@ -159,8 +161,9 @@ RegistrationResult register_scans(const PointCloud& target, const PointCloud& so
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.4f (at least %.4f needed)", q.weakest_constraint,
                   c.min_constraint);
-    r.message = std::string("the matched surfaces leave the pose nearly free in one direction "
-                            "(weakest constraint ") +
+    r.message = std::string(
+                    "the matched surfaces leave the pose nearly free in one direction "
+                    "(weakest constraint ") +
                 buf + "): a corridor or a single wall, along which the match cannot be trusted";
   }
   return r;

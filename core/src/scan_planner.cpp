@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -52,7 +53,8 @@ void check_config(const PlannerConfig& c) {
   const auto fail = [](const std::string& what) {
     throw std::invalid_argument("planner config: " + what);
   };
-  if (!(c.alpha >= 0 && c.alpha <= 1)) fail("alpha must be in [0, 1], got " + std::to_string(c.alpha));
+  if (!(c.alpha >= 0 && c.alpha <= 1))
+    fail("alpha must be in [0, 1], got " + std::to_string(c.alpha));
   if (c.hill_climb_starts < 1) fail("hill_climb_starts must be at least 1");
   if (!(c.hill_climb_step_m > 0)) fail("hill_climb_step_m must be greater than zero");
   if (c.hill_climb_samples < 0) fail("hill_climb_samples must be zero or more");
@@ -89,7 +91,9 @@ int thread_count(const PlannerConfig& cfg) {
 #endif
 }
 
-int floor_mod(int a, int b) { return ((a % b) + b) % b; }
+int floor_mod(int a, int b) {
+  return ((a % b) + b) % b;
+}
 
 // Movable cells a scan may be planned at, with what the policies need to know about them.
 struct Sites {
@@ -104,7 +108,8 @@ struct Sites {
   }
 };
 
-Sites collect_sites(const MlsMap& map, const MovableRegion& movable, const TravelMap& travel) {
+Sites collect_sites(const MlsMap& map, const MovableRegion& movable, const TravelMap& travel,
+                    const TargetRegion* within) {
   Sites s;
   const auto& g = movable.patch;
   s.index = CellGrid<std::int32_t>(g.origin, g.cols, g.rows, g.cell_m, -1);
@@ -112,9 +117,10 @@ Sites collect_sites(const MlsMap& map, const MovableRegion& movable, const Trave
     if (g.values[o] < 0) continue;
     const CellIndex c = g.index_at(o);
     const double d = travel.distance(c);
-    // Travel was only allowed where the robot may go (the target region), and only there
-    // may it scan.
     if (!std::isfinite(d)) continue;
+    // The robot may start outside the target region, but it scans only inside.
+    const Eigen::Vector2d centre = map.center_of(c);
+    if (within && !within->contains(centre.x(), centre.y())) continue;
     s.index.values[o] = static_cast<std::int32_t>(s.cell.size());
     s.cell.push_back(c);
     // The robot stands on the floor's surface: its mean height, the measured ground.
@@ -130,9 +136,22 @@ struct Scored {
   double score = 0;
 };
 
+// What a policy ranks by, from a site and its gain.
+using Scorer = std::function<double(std::int32_t site, const ScanGain& gain)>;
+// A policy's score once the best F of a first look over the region is known.
+using ScorerFor = std::function<Scorer(double best_f)>;
+
+double by_gain(std::int32_t, const ScanGain& g) {
+  return g.f;
+}
+Scorer gain_only(double) {
+  return by_gain;
+}
+
 // F at the given sites, shared over the threads; the order of `which` is kept.
 std::vector<Scored> evaluate_sites(const ScanGainEvaluator& gain, const Sites& sites,
-                                   const std::vector<std::int32_t>& which, int threads) {
+                                   const std::vector<std::int32_t>& which, int threads,
+                                   const Scorer& score = by_gain) {
   std::vector<Scored> out(which.size());
 #pragma omp parallel num_threads(threads)
   {
@@ -142,7 +161,7 @@ std::vector<Scored> evaluate_sites(const ScanGainEvaluator& gain, const Sites& s
       const auto s = static_cast<std::size_t>(which[k]);
       out[k].site = which[k];
       out[k].gain = gain.at(sites.cell[s], sites.floor_z[s], ws);
-      out[k].score = out[k].gain.f;
+      out[k].score = score(which[k], out[k].gain);
     }
   }
   return out;
@@ -189,16 +208,18 @@ std::vector<std::int32_t> lattice_sites(const Sites& sites, double lattice_m, do
   return which;
 }
 
-// Paper §3.4: hill climbing on F from several random starts. Each climb moves to its best
-// 8-neighbour at the current move length while F improves, then halves the move; climbs run
-// in parallel, each with its own memory of evaluated cells, so the result and the count of
-// evaluations are the same whatever the thread count.
+// Paper §3.4: hill climbing on F (or another score) from several random starts. Each climb
+// moves to its best 8-neighbour at the current move length while the score improves, then
+// halves the move; climbs run in parallel, each with its own memory of evaluated cells, so
+// the result and the count of evaluations are the same whatever the thread count.
 std::vector<Scored> hill_climb(const ScanGainEvaluator& gain, const Sites& sites,
                                const PlannerConfig& cfg, double cell_m, int threads,
-                               std::size_t& evaluations) {
+                               const ScorerFor& scorer_for, std::size_t& evaluations) {
   SplitMix rng(cfg.seed);
   std::vector<std::int32_t> starts;
   std::vector<Scored> screened;
+  Scorer score;
+  std::size_t evaluations_before = 0;
   if (cfg.hill_climb_samples > 0) {
     // The starts are the best of a random sample rather than the sample's first few: the
     // same randomised initial locations, but the climbs begin on the hills worth climbing.
@@ -206,28 +227,46 @@ std::vector<Scored> hill_climb(const ScanGainEvaluator& gain, const Sites& sites
     // movable region: random like the paper's starts, but spread evenly, so no part of the
     // region is left without a start nearby.
     const int stride = std::max(
-        1, static_cast<int>(std::lround(std::sqrt(static_cast<double>(sites.size()) / cfg.hill_climb_samples))));
+        1, static_cast<int>(
+               std::lround(std::sqrt(static_cast<double>(sites.size()) / cfg.hill_climb_samples))));
     const int ox = static_cast<int>(rng.below(static_cast<std::size_t>(stride)));
     const int oy = static_cast<int>(rng.below(static_cast<std::size_t>(stride)));
     std::vector<std::int32_t> sample;
     for (std::size_t s = 0; s < sites.size(); ++s) {
-      if (floor_mod(sites.cell[s].x - ox, stride) == 0 && floor_mod(sites.cell[s].y - oy, stride) == 0) {
+      if (floor_mod(sites.cell[s].x - ox, stride) == 0 &&
+          floor_mod(sites.cell[s].y - oy, stride) == 0) {
         sample.push_back(static_cast<std::int32_t>(s));
       }
     }
     // A region thinner than the lattice still gets a start.
     if (sample.empty()) sample.push_back(static_cast<std::int32_t>(rng.below(sites.size())));
     screened = evaluate_sites(gain, sites, sample, threads);
+    double best_f = 0;
+    for (const Scored& x : screened) best_f = std::max(best_f, x.gain.f);
+    score = scorer_for(best_f);
+    for (Scored& x : screened) x.score = score(x.site, x.gain);
     std::vector<Scored> order = screened;
     std::stable_sort(order.begin(), order.end(),
                      [](const Scored& a, const Scored& b) { return a.score > b.score; });
-    for (std::size_t k = 0; k < order.size() && static_cast<int>(starts.size()) < cfg.hill_climb_starts; ++k) {
+    for (std::size_t k = 0;
+         k < order.size() && static_cast<int>(starts.size()) < cfg.hill_climb_starts; ++k) {
       starts.push_back(order[k].site);
     }
   } else {
-    for (int k = 0; k < cfg.hill_climb_starts; ++k) starts.push_back(static_cast<std::int32_t>(rng.below(sites.size())));
+    for (int k = 0; k < cfg.hill_climb_starts; ++k)
+      starts.push_back(static_cast<std::int32_t>(rng.below(sites.size())));
+    // No first look: the best F is that of the starts.
+    double best_f = 0;
+    for (const std::int32_t s : starts) {
+      best_f = std::max(best_f, gain.at(sites.cell[static_cast<std::size_t>(s)],
+                                        sites.floor_z[static_cast<std::size_t>(s)])
+                                    .f);
+    }
+    evaluations_before = starts.size();
+    score = scorer_for(best_f);
   }
-  const int first_stride = std::max(1, static_cast<int>(std::lround(cfg.hill_climb_step_m / cell_m)));
+  const int first_stride =
+      std::max(1, static_cast<int>(std::lround(cfg.hill_climb_step_m / cell_m)));
   static constexpr int kDx[8] = {1, 1, 0, -1, -1, -1, 0, 1};
   static constexpr int kDy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
 
@@ -237,43 +276,44 @@ std::vector<Scored> hill_climb(const ScanGainEvaluator& gain, const Sites& sites
     auto ws = gain.workspace();
 #pragma omp for schedule(dynamic, 1)
     for (std::size_t k = 0; k < starts.size(); ++k) {
-      std::unordered_map<std::int32_t, ScanGain> memo;
+      std::unordered_map<std::int32_t, double> memo;
       auto& seen = visited[k];
-      const auto f_at = [&](std::int32_t s) {
+      const auto value_at = [&](std::int32_t s) {
         const auto it = memo.find(s);
-        if (it != memo.end()) return it->second.f;
+        if (it != memo.end()) return it->second;
         const auto u = static_cast<std::size_t>(s);
         const ScanGain g = gain.at(sites.cell[u], sites.floor_z[u], ws);
-        memo.emplace(s, g);
-        seen.push_back({s, g, g.f});
-        return g.f;
+        const double v = score(s, g);
+        memo.emplace(s, v);
+        seen.push_back({s, g, v});
+        return v;
       };
       std::int32_t at = starts[k];
-      double f = f_at(at);
+      double value = value_at(at);
       for (int stride = first_stride; stride >= 1; stride /= 2) {
         for (;;) {
           std::int32_t best = -1;
-          double best_f = f;
+          double best_value = value;
           const CellIndex c = sites.cell[static_cast<std::size_t>(at)];
           for (int n = 0; n < 8; ++n) {
             const std::int32_t s = sites.at({c.x + stride * kDx[n], c.y + stride * kDy[n]});
             if (s < 0) continue;
-            const double fs = f_at(s);
-            if (fs > best_f) {
-              best_f = fs;
+            const double v = value_at(s);
+            if (v > best_value) {
+              best_value = v;
               best = s;
             }
           }
           if (best < 0) break;
           at = best;
-          f = best_f;
+          value = best_value;
         }
       }
     }
   }
   std::vector<Scored> all;
   std::vector<bool> taken(sites.size(), false);
-  evaluations = screened.size();
+  evaluations = evaluations_before + screened.size();
   for (const Scored& s : screened) {
     taken[static_cast<std::size_t>(s.site)] = true;
     all.push_back(s);
@@ -314,12 +354,12 @@ std::vector<Scored> first_worth_scanning(const ScanGainEvaluator& gain, const Si
   const double sep2 = std::pow(cfg.candidate_separation_m / cell_m, 2);
   std::vector<Scored> out;
   const std::size_t batch = static_cast<std::size_t>(std::max(8, 4 * threads));
-  for (std::size_t begin = 0;
-       begin < order.size() && evaluations < kMaxBaselineEvaluations &&
-       static_cast<int>(out.size()) < cfg.max_candidates;
+  for (std::size_t begin = 0; begin < order.size() && evaluations < kMaxBaselineEvaluations &&
+                              static_cast<int>(out.size()) < cfg.max_candidates;
        begin += batch) {
-    const std::vector<std::int32_t> part(order.begin() + static_cast<std::ptrdiff_t>(begin),
-                                         order.begin() + static_cast<std::ptrdiff_t>(std::min(order.size(), begin + batch)));
+    const std::vector<std::int32_t> part(
+        order.begin() + static_cast<std::ptrdiff_t>(begin),
+        order.begin() + static_cast<std::ptrdiff_t>(std::min(order.size(), begin + batch)));
     evaluations += part.size();
     for (const Scored& s : evaluate_sites(gain, sites, part, threads)) {
       if (static_cast<int>(out.size()) == cfg.max_candidates) break;
@@ -372,11 +412,13 @@ std::optional<Eigen::Vector3d> nearest_floor(const MlsMap& map, const Eigen::Vec
 
 Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
   check_config(cfg);
-  if (!in.robot.allFinite()) throw std::invalid_argument("plan_next_scan: the robot position is not finite");
+  if (!in.robot.allFinite())
+    throw std::invalid_argument("plan_next_scan: the robot position is not finite");
   const auto t0 = std::chrono::steady_clock::now();
   Plan plan;
   const auto finish = [&]() -> Plan {
-    plan.plan_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    plan.plan_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     return std::move(plan);
   };
   plan.regions = segment_regions(in.map, in.target, in.scan_points, cfg.regions);
@@ -392,11 +434,13 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
       plan.movable = movable_region(in.map, start, cfg.movable);
     }
   }
-  if (plan.movable.cells == 0 || plan.regions.unscanned + plan.regions.low_resolution == 0) return finish();
+  if (plan.movable.cells == 0 || plan.regions.unscanned + plan.regions.low_resolution == 0)
+    return finish();
 
-  const TravelMap travel =
-      travel_map(in.map, plan.movable, start, cfg.movable, cfg.stay_in_target ? &in.target : nullptr);
-  const Sites sites = collect_sites(in.map, plan.movable, travel);
+  const TravelMap travel = travel_map(in.map, plan.movable, start, cfg.movable,
+                                      cfg.stay_in_target ? &in.target : nullptr);
+  const Sites sites =
+      collect_sites(in.map, plan.movable, travel, cfg.stay_in_target ? &in.target : nullptr);
   if (sites.size() == 0) return finish();
   const ScanGainEvaluator gain(in.map, plan.regions, cfg.alpha, cfg.regions, cfg.visibility);
   const double cell_m = in.map.cell_m();
@@ -405,20 +449,28 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
   std::vector<Scored> chosen;
   switch (cfg.policy) {
     case PlannerPolicy::kPaper: {
-      chosen = rank(hill_climb(gain, sites, cfg, cell_m, threads, plan.evaluations), sites, cfg, cell_m);
+      chosen = rank(hill_climb(gain, sites, cfg, cell_m, threads, gain_only, plan.evaluations),
+                    sites, cfg, cell_m);
       break;
     }
-    case PlannerPolicy::kExhaustive:
-    case PlannerPolicy::kTravel: {
-      const auto which = lattice_sites(sites, cfg.lattice_m, cell_m);
-      auto all = evaluate_sites(gain, sites, which, threads);
+    case PlannerPolicy::kExhaustive: {
+      auto all = evaluate_sites(gain, sites, lattice_sites(sites, cfg.lattice_m, cell_m), threads);
       plan.evaluations = all.size();
-      if (cfg.policy == PlannerPolicy::kTravel) {
-        for (Scored& s : all) {
-          s.score = s.gain.f - cfg.travel_cost_per_m * sites.travel_m[static_cast<std::size_t>(s.site)];
-        }
-      }
       chosen = rank(std::move(all), sites, cfg, cell_m);
+      break;
+    }
+    case PlannerPolicy::kTravel: {
+      // A metre of driving costs travel_cost_per_m of the best F in view, so the trade keeps
+      // its balance as the gains shrink over a mission. The drive is smooth over the region,
+      // so the traded score is climbed as F is.
+      const ScorerFor traded = [&](double best_f) -> Scorer {
+        const double per_m = cfg.travel_cost_per_m * best_f;
+        return [&sites, per_m](std::int32_t site, const ScanGain& g) {
+          return g.f - per_m * sites.travel_m[static_cast<std::size_t>(site)];
+        };
+      };
+      chosen = rank(hill_climb(gain, sites, cfg, cell_m, threads, traded, plan.evaluations), sites,
+                    cfg, cell_m);
       break;
     }
     case PlannerPolicy::kNearestFrontier: {
@@ -427,7 +479,8 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
       auto order = frontier_sites(sites, plan.regions, Region::kUnscanned);
       if (order.empty()) order = frontier_sites(sites, plan.regions, Region::kLowResolution);
       std::stable_sort(order.begin(), order.end(), [&](std::int32_t a, std::int32_t b) {
-        return sites.travel_m[static_cast<std::size_t>(a)] < sites.travel_m[static_cast<std::size_t>(b)];
+        return sites.travel_m[static_cast<std::size_t>(a)] <
+               sites.travel_m[static_cast<std::size_t>(b)];
       });
       chosen = first_worth_scanning(gain, sites, order, cfg, cell_m, threads, plan.evaluations);
       for (Scored& s : chosen) s.score = -sites.travel_m[static_cast<std::size_t>(s.site)];

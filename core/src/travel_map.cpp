@@ -7,7 +7,9 @@
 
 namespace scanplan {
 
-bool TravelMap::reachable(CellIndex c) const { return std::isfinite(distance(c)); }
+bool TravelMap::reachable(CellIndex c) const {
+  return std::isfinite(distance(c));
+}
 
 double TravelMap::distance(CellIndex c) const {
   const auto o = distance_m.offset(c);
@@ -58,7 +60,8 @@ TravelMap travel_map(const MlsMap& map, const MovableRegion& movable, const Eige
         const CellIndex c{rc.x + dx, rc.y + dy};
         const auto o = grid.offset(c);
         if (!o || grid.values[*o] < 0) continue;
-        const float d = std::abs(map.cell(c)->patches[grid.values[*o]].max_z - static_cast<float>(robot.z()));
+        const float d =
+            std::abs(map.cell(c)->patches[grid.values[*o]].max_z - static_cast<float>(robot.z()));
         if (d < best) {
           best = d;
           start = static_cast<std::int64_t>(*o);

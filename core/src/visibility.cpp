@@ -82,14 +82,16 @@ VisibilityPredictor::VisibilityPredictor(const MlsMap& map, CellIndex raster_ori
   }
 
   // The vertical fan exactly as ScannerConfig::vertical_samples counts it.
-  beams_ = static_cast<int>(std::floor(config.vertical_fov_deg / config.elevation_step_deg + 1e-9)) + 1;
+  beams_ =
+      static_cast<int>(std::floor(config.vertical_fov_deg / config.elevation_step_deg + 1e-9)) + 1;
   el0_ = static_cast<float>(deg2rad(-config.vertical_fov_deg / 2));
   inv_el_step_ = static_cast<float>(1.0 / deg2rad(config.elevation_step_deg));
   slope_.resize(static_cast<std::size_t>(beams_));
   inv_slope_.resize(static_cast<std::size_t>(beams_));
   for (int k = 0; k < beams_; ++k) {
     const auto u = static_cast<std::size_t>(k);
-    slope_[u] = static_cast<float>(std::tan(deg2rad(-config.vertical_fov_deg / 2 + k * config.elevation_step_deg)));
+    slope_[u] = static_cast<float>(
+        std::tan(deg2rad(-config.vertical_fov_deg / 2 + k * config.elevation_step_deg)));
     inv_slope_[u] = 1.0f / slope_[u];
   }
 
@@ -97,8 +99,10 @@ VisibilityPredictor::VisibilityPredictor(const MlsMap& map, CellIndex raster_ori
   sensor_min_ = raster_origin;
   sensor_max_ = {raster_origin.x + raster_cols - 1, raster_origin.y + raster_rows - 1};
   if (const auto extent = map.extent()) {
-    sensor_min_ = {std::min(sensor_min_.x, extent->first.x), std::min(sensor_min_.y, extent->first.y)};
-    sensor_max_ = {std::max(sensor_max_.x, extent->second.x), std::max(sensor_max_.y, extent->second.y)};
+    sensor_min_ = {std::min(sensor_min_.x, extent->first.x),
+                   std::min(sensor_min_.y, extent->first.y)};
+    sensor_max_ = {std::max(sensor_max_.x, extent->second.x),
+                   std::max(sensor_max_.y, extent->second.y)};
   }
   const int pad = static_cast<int>(std::ceil(config.max_range_m / cell_m_)) + 2;
   dense_origin_ = {sensor_min_.x - pad, sensor_min_.y - pad};
@@ -150,7 +154,8 @@ VisibilityPredictor::VisibilityPredictor(const MlsMap& map, CellIndex raster_ori
       walk(az, to / cell_m_, sensor_offset);
       ray.walk_end = static_cast<std::uint32_t>(steps_.size());
       ray.segment_begin = ray.walk_begin;
-      while (ray.segment_begin < ray.walk_end && steps_[ray.segment_begin].d0 < from) ++ray.segment_begin;
+      while (ray.segment_begin < ray.walk_end && steps_[ray.segment_begin].d0 < from)
+        ++ray.segment_begin;
       rays_.push_back(ray);
     }
   }
@@ -244,10 +249,13 @@ void VisibilityPredictor::find_thin_objects() {
         }
       }
     }
-    if (i_max - i_min > 1 || j_max - j_min > 1 || thin_centres_.size() >= static_cast<std::size_t>(std::numeric_limits<std::int16_t>::max())) continue;
+    if (i_max - i_min > 1 || j_max - j_min > 1 ||
+        thin_centres_.size() >= static_cast<std::size_t>(std::numeric_limits<std::int16_t>::max()))
+      continue;
     const float cx = static_cast<float>((i_min + i_max + 1) * 0.5 * cell_m_);
     const float cy = static_cast<float>((j_min + j_max + 1) * 0.5 * cell_m_);
-    for (const std::int32_t c : group) dense_[static_cast<std::size_t>(c)].thin = static_cast<std::int16_t>(thin_centres_.size());
+    for (const std::int32_t c : group)
+      dense_[static_cast<std::size_t>(c)].thin = static_cast<std::int16_t>(thin_centres_.size());
     thin_centres_.emplace_back(cx, cy);
   }
 }
@@ -261,8 +269,8 @@ VisibilityPredictor::Workspace VisibilityPredictor::workspace() const {
 struct VisibilityPredictor::Trace {
   float sz, floor, ceiling, min_r2, max_r2, ground_extent, ground_jump, min_fill, min_clip;
   float thin_radius;
-  std::size_t base;  // the sensor's cell in the dense map
-  std::int64_t i0, j0;  // the sensor's cell in the raster
+  std::size_t base;           // the sensor's cell in the dense map
+  std::int64_t i0, j0;        // the sensor's cell in the raster
   Eigen::Vector2f sensor_xy;  // metres from the dense map's corner
   Eigen::Vector2f dir;        // of the ray being traced
   float half_spacing;         // half the angle to the neighbouring rays at this level
@@ -270,8 +278,8 @@ struct VisibilityPredictor::Trace {
 
 struct VisibilityPredictor::RayState {
   std::uint64_t free[kMaxBeamWords];  // beams not yet stopped
-  int k_min, k_max;  // the lowest and highest of them
-  float ground;      // the ground height carried along the ray
+  int k_min, k_max;                   // the lowest and highest of them
+  float ground;                       // the ground height carried along the ray
   bool done = false;  // nothing more to see along this ray or the rays it splits into
   // The previous return of a descending beam, for the gap filling between neighbours.
   bool have_last = false, last_usable = false;
@@ -287,8 +295,10 @@ void VisibilityPredictor::mark(const Trace& t, const Step& s, Workspace& ws) con
   ws.visible.push_back(static_cast<std::uint32_t>(o));
 }
 
-void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st, Workspace& ws) const {
-  const Ray& ray = rays_[level_offset_[static_cast<std::size_t>(level)] + static_cast<std::size_t>(m)];
+void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
+                                Workspace& ws) const {
+  const Ray& ray =
+      rays_[level_offset_[static_cast<std::size_t>(level)] + static_cast<std::size_t>(m)];
   Trace t = tr;
   t.dir = ray.dir;
   t.half_spacing = static_cast<float>(0.5 * 2 * M_PI / azimuths_ * (1 << level));
@@ -325,7 +335,8 @@ void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
     const bool usable = z0 < sz && d0 > 0.3f;
     if (fill_ && st.have_last && st.last_usable && usable && d0 > st.last_d) {
       const float length = d0 - st.last_d;
-      if (length >= t.min_fill && length <= fill_max_gap_ && std::abs(z0 - st.last_z) <= fill_max_slope_ * length) {
+      if (length >= t.min_fill && length <= fill_max_gap_ &&
+          std::abs(z0 - st.last_z) <= fill_max_slope_ * length) {
         for (const Step* p = s - 1; p >= walk && p->d0 >= st.last_d; --p) {
           // A corner the walk only clips is usually missed by the fill's half-cell samples.
           if (p->d1 - p->d0 >= t.min_clip) mark(t, *p, ws);
@@ -353,7 +364,8 @@ void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
     const bool hanging = cell.n > 0 && cell.lo0 > st.ground + t.ground_jump;
     const bool assume = cell.n == 0 || hanging;
     if (assume && !config_.unknown_as_ground && cell.n == 0) continue;
-    if (!assume && cell.hi0 - cell.lo0 <= t.ground_extent && std::abs(cell.hi0 - st.ground) <= t.ground_jump) {
+    if (!assume && cell.hi0 - cell.lo0 <= t.ground_extent &&
+        std::abs(cell.hi0 - st.ground) <= t.ground_jump) {
       st.ground = cell.hi0;
     }
     // Most cells lie wholly below the lowest free beam (ground already passed over).
@@ -376,7 +388,8 @@ void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
       lo_hi[0] = -kSolid;
       // A ray passing beside a thin object meets only the ground at its foot.
       if (cell.thin >= 0) {
-        const Eigen::Vector2f rel = thin_centres_[static_cast<std::size_t>(cell.thin)] - t.sensor_xy;
+        const Eigen::Vector2f rel =
+            thin_centres_[static_cast<std::size_t>(cell.thin)] - t.sensor_xy;
         // At least half the gap to the neighbouring rays, or an object between two rays
         // would stop neither.
         const float radius = std::max(t.thin_radius, s->d0 * t.half_spacing);
@@ -395,7 +408,8 @@ void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
       // above it, found by walking the slope table; atan only for tall spans.
       int k0 = st.k_min;
       if (t_lo > slope[k0]) {
-        k0 = std::max(st.k_min, static_cast<int>(std::ceil((fast_atan(t_lo) - el0_) * inv_el_step_)));
+        k0 = std::max(st.k_min,
+                      static_cast<int>(std::ceil((fast_atan(t_lo) - el0_) * inv_el_step_)));
         while (k0 > st.k_min && slope[k0 - 1] >= t_lo) --k0;
         while (k0 <= st.k_max && slope[k0] < t_lo) ++k0;
         if (k0 > st.k_max) continue;
@@ -409,7 +423,8 @@ void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
           ++walked;
         }
         if (walked == 8) {
-          k1 = std::min(st.k_max, static_cast<int>(std::floor((fast_atan(t_hi) - el0_) * inv_el_step_)));
+          k1 = std::min(st.k_max,
+                        static_cast<int>(std::floor((fast_atan(t_hi) - el0_) * inv_el_step_)));
           while (k1 < st.k_max && slope[k1 + 1] <= t_hi) ++k1;
           while (k1 >= k0 && slope[k1] > t_hi) --k1;
         }
@@ -459,14 +474,15 @@ void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
     }
   }
   if (level == 0) return;
-  // Split: the ray goes on at its azimuth, and a new one starts half-way to its neighbour
-  // with everything this one has seen so far.
+  // Split in two, each at the middle of one half of this ray's sector, both going on with
+  // everything this one has seen so far.
   RayState other = st;
   trace(t, level - 1, 2 * m, st, ws);
   trace(t, level - 1, 2 * m + 1, other, ws);
 }
 
-const std::vector<std::uint32_t>& VisibilityPredictor::visible_from(CellIndex sensor, double floor_z,
+const std::vector<std::uint32_t>& VisibilityPredictor::visible_from(CellIndex sensor,
+                                                                    double floor_z,
                                                                     Workspace& ws) const {
   if (sensor.x < sensor_min_.x || sensor.y < sensor_min_.y || sensor.x > sensor_max_.x ||
       sensor.y > sensor_max_.y) {
@@ -474,7 +490,8 @@ const std::vector<std::uint32_t>& VisibilityPredictor::visible_from(CellIndex se
                             std::to_string(sensor.y) +
                             ") is outside the map and raster the predictor was built for");
   }
-  if (!std::isfinite(floor_z)) throw std::invalid_argument("visibility: floor height is not finite");
+  if (!std::isfinite(floor_z))
+    throw std::invalid_argument("visibility: floor height is not finite");
   if (ws.stamp.size() != static_cast<std::size_t>(raster_cols_) * raster_rows_) ws = workspace();
   if (++ws.epoch == 0) {
     std::fill(ws.stamp.begin(), ws.stamp.end(), 0);
@@ -498,8 +515,10 @@ const std::vector<std::uint32_t>& VisibilityPredictor::visible_from(CellIndex se
   t.i0 = sensor.x - raster_origin_.x;
   t.j0 = sensor.y - raster_origin_.y;
   t.thin_radius = static_cast<float>(config_.thin_object_radius_m);
-  t.sensor_xy = ((Eigen::Vector2d(sensor.x - dense_origin_.x, sensor.y - dense_origin_.y) + sensor_offset_) * cell_m_)
-                    .cast<float>();
+  t.sensor_xy =
+      ((Eigen::Vector2d(sensor.x - dense_origin_.x, sensor.y - dense_origin_.y) + sensor_offset_) *
+       cell_m_)
+          .cast<float>();
 
   RayState start;
   const int words = (beams_ + 63) >> 6;

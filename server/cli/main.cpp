@@ -4,6 +4,7 @@
 
 #include <iostream>
 
+#include "register_command.hpp"
 #include "replay_command.hpp"
 #include "scan_command.hpp"
 #include "simulate_command.hpp"
@@ -12,6 +13,7 @@ int main(int argc, char** argv) {
   CLI::App app{"scanplan: offline tools and terminal operator for the scanplan workstation"};
   app.require_subcommand(1);
   scanplan::cli::add_scan_command(app);
+  scanplan::cli::add_register_command(app);
   scanplan::cli::add_replay_command(app);
   scanplan::cli::add_simulate_command(app);
   try {

@@ -171,14 +171,15 @@ TEST_F(WallYard, TravelTradesGainForDistance) {
   PlannerConfig cfg;
   cfg.policy = PlannerPolicy::kTravel;
   cfg.travel_cost_per_m = 0;
-  const Plan free_travel = plan_next_scan(input(), cfg);
-  const Plan exhaustive = plan(PlannerPolicy::kExhaustive, 0.5);
-  EXPECT_EQ(free_travel.ranked.front().position, exhaustive.ranked.front().position);
-  cfg.travel_cost_per_m = 100;  // a metre is worth more than any cell a scan could add
-  const Plan costly = plan_next_scan(input(), cfg);
-  const Candidate& near = costly.ranked.front();
+  const Candidate free_travel = plan_next_scan(input(), cfg).ranked.front();
+  const Candidate best = plan(PlannerPolicy::kExhaustive, 0.5).ranked.front();
+  EXPECT_GE(free_travel.f, 0.98 * best.f) << "with driving free, travel climbs F as paper does";
+  EXPECT_DOUBLE_EQ(free_travel.score, free_travel.f);
+  cfg.travel_cost_per_m = 0.1;  // 10 m of driving cost the best scan's whole gain
+  const Candidate near = plan_next_scan(input(), cfg).ranked.front();
   EXPECT_LT(near.travel_m, 5.0);
-  EXPECT_NEAR(near.score, near.f - 100 * near.travel_m, 1e-6);
+  EXPECT_LE(near.score, near.f);
+  EXPECT_GT(near.f, 0);
 }
 
 TEST_F(WallYard, EvaluateAgreesWithThePlan) {

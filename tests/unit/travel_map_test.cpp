@@ -41,7 +41,8 @@ TEST(TravelMap, GoesRoundAWallAndNotUpAStep) {
   map.insert(slab(0, 20, 0, 20, 0.0f));
   // A wall at x = 10 from y = 0 to 15: the way from (5, 5) to (15, 5) goes round its end.
   for (int y = 0; y < 15; ++y) {
-    for (float z = 0; z <= 2.0f; z += 0.25f) map.insert(std::vector<Eigen::Vector3f>{{10.5f, y + 0.5f, z}});
+    for (float z = 0; z <= 2.0f; z += 0.25f)
+      map.insert(std::vector<Eigen::Vector3f>{{10.5f, y + 0.5f, z}});
   }
   // A platform 0.2 m up beyond x = 20, higher than the robot climbs.
   map.insert(slab(20, 25, 0, 20, 0.2f));

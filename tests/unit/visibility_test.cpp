@@ -48,7 +48,8 @@ TEST(Visibility, WallHidesTheGroundBehindIt) {
   EXPECT_TRUE(seen(g, 25, 10));
   EXPECT_TRUE(seen(g, 20, 30));
   EXPECT_TRUE(seen(g, 30, 10)) << "the wall itself";
-  for (const auto& [x, y] : std::vector<std::pair<int, int>>{{32, 10}, {35, 5}, {40, 12}, {45, 8}}) {
+  for (const auto& [x, y] :
+       std::vector<std::pair<int, int>>{{32, 10}, {35, 5}, {40, 12}, {45, 8}}) {
     EXPECT_FALSE(seen(g, x, y)) << x << ", " << y << " is behind the wall";
   }
   EXPECT_TRUE(seen(g, 38, 32)) << "past the wall's end";
@@ -162,8 +163,9 @@ TEST(Visibility, AgreesWithTheScanItPredictsOnTheCampus) {
   b.y = 45.5;
   const CellIndex bc = map.index_of(b.x, b.y);
   ASSERT_NE(map.cell(bc), nullptr);
-  const auto predicted = predict_visible(map, regions.cells, {b.x, b.y}, map.cell(bc)->patches[0].mean_z,
-                                         VisibilityConfig::from_scanner(w.scanner));
+  const auto predicted =
+      predict_visible(map, regions.cells, {b.x, b.y}, map.cell(bc)->patches[0].mean_z,
+                      VisibilityConfig::from_scanner(w.scanner));
   MlsMap alone;
   alone.insert_scan(simulate_scan(caster, w.scanner, b, 7), b.isometry(), sensor);
   std::size_t both = 0, either = 0, both_new = 0, either_new = 0;
@@ -189,7 +191,8 @@ TEST(Visibility, BadInputIsRefusedWithAReason) {
   MlsMap map;
   map.insert(slab(0, 10, 0, 10, 0.0f));
   EXPECT_THROW(predict_visible(map, raster(10, 10), {500.0, 5.0}, 0.0, {}), std::out_of_range);
-  EXPECT_THROW(predict_visible(map, raster(10, 10), {5.0, 5.0}, std::nan(""), {}), std::invalid_argument);
+  EXPECT_THROW(predict_visible(map, raster(10, 10), {5.0, 5.0}, std::nan(""), {}),
+               std::invalid_argument);
   VisibilityConfig bad;
   bad.azimuth_step_deg = 0;
   EXPECT_THROW(predict_visible(map, raster(10, 10), {5.0, 5.0}, 0.0, bad), std::invalid_argument);

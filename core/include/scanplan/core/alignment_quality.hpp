@@ -30,8 +30,11 @@ struct AlignmentQuality {
 // Scores `source` moved by `source_to_target` against `target`. The paper does not say how
 // Eq. 2 treats points seen by one scan only; without a cut they dominate the sum and the score
 // says more about the overlap than about the match, so each term is min(d², score_max²).
+// `weakest_constraint` needs a surface normal per inlier, which costs as much as the rest: it is
+// left at 0 unless `with_constraint`.
 AlignmentQuality evaluate_alignment(const PointCloud& target, const PointCloud& source,
                                     const Eigen::Isometry3d& source_to_target, Dof dof,
-                                    double score_max_distance_m, double inlier_distance_m);
+                                    double score_max_distance_m, double inlier_distance_m,
+                                    bool with_constraint = true);
 
 }  // namespace scanplan

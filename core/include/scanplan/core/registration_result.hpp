@@ -26,9 +26,10 @@ struct RegistrationResult {
   double inlier_ratio = 0;  // share of source points with a target point within the inlier distance
   int iterations = 0;       // summed over all stages (cell sizes, NDT then ICP)
   double time_ms = 0;       // the alignment itself: downsampling and scoring excluded
-  bool converged = false;   // the solver stopped on its tolerances AND the result passed the sanity check
-  std::string method;       // "ndt-icp", "ndt", "icp", "pcl-ndt", "pcl-icp", "pcl-gicp"
-  std::string message;      // why it did not converge, or a note (e.g. "PCL solves 6 DOF")
+  bool converged =
+      false;  // the solver stopped on its tolerances AND the result passed the sanity check
+  std::string method;   // "ndt-icp", "ndt", "icp", "pcl-ndt", "pcl-icp", "pcl-gicp"
+  std::string message;  // why it did not converge, or a note (e.g. "PCL solves 6 DOF")
 };
 
 }  // namespace scanplan

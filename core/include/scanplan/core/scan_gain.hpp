@@ -22,6 +22,7 @@ struct ScanGain {
 class ScanGainEvaluator {
  public:
   // `alpha` is the paper's weight α (§3.4), in [0, 1]; throws std::invalid_argument otherwise.
+  // `regions` must outlive the evaluator; the map is copied.
   ScanGainEvaluator(const MlsMap& map, const RegionMap& regions, double alpha,
                     const RegionConfig& region_config, const VisibilityConfig& visibility);
 

@@ -16,11 +16,11 @@ namespace scanplan {
 
 // How the next scan point is chosen among the movable cells (paper §3.4 and beyond it).
 enum class PlannerPolicy {
-  kPaper,           // hill climbing on F from seeded random starts (paper §3.4)
-  kExhaustive,      // F at every movable cell (or every lattice_m), the best wins
-  kTravel,          // F traded against the drive there (paper §5 future work)
+  kPaper,            // hill climbing on F from seeded random starts (paper §3.4)
+  kExhaustive,       // F at every movable cell (or every lattice_m), the best wins
+  kTravel,           // F traded against the drive there (paper §5 future work)
   kNearestFrontier,  // the nearest movable cell next to unscanned cells (Yamauchi's frontiers)
-  kRandom,          // a seeded random movable cell where a scan gains something
+  kRandom,           // a seeded random movable cell where a scan gains something
 };
 
 // "paper", "exhaustive", "travel", "nearest-frontier", "random"; nothing for other names.
@@ -31,24 +31,28 @@ struct PlannerConfig {
   PlannerPolicy policy = PlannerPolicy::kPaper;
   double alpha = 0.5;  // paper Eq. 1 weight α (§3.4); §3.5 uses 0.5
   std::uint64_t seed = 1;
-  int hill_climb_starts = 8;  // paper §3.4: hill climbing "from several randomized initial locations"
+  // Paper §3.4: hill climbing "from several randomized initial locations".
+  int hill_climb_starts = 8;
   // Hill climbing moves to the best of the 8 neighbours this far away while that improves F,
   // then halves the move down to one cell: the long moves cross F's small local ripples
   // (cell-sized noise of the discrete beams) that stop a one-cell climb early.
   double hill_climb_step_m = 4.0;
   // The starts are the best hill_climb_starts of about this many movable cells on a lattice
   // at a random offset (0: hill_climb_starts random cells, as the paper has it). Over 20
-  // steps on the campus this brings the climbs within 0.2% of the exhaustive optimum, against
-  // several per cent from purely random starts (docs/benchmarks.md).
+  // steps on the campus this brings the climbs within 0.6% of the exhaustive optimum on
+  // average, against 6% from purely random starts (docs/benchmarks.md).
   int hill_climb_samples = 1024;
-  double lattice_m = 1.0;  // exhaustive and travel: candidate spacing (one cell at most)
+  double lattice_m = 1.0;  // exhaustive: candidate spacing, in whole cells
   int max_candidates = 5;  // ranked list length
-  // travel: score = F − travel_cost_per_m · path length. F is in m² of map gained, so this is
-  // the gain a metre of driving must buy: 5 m²/m lets a site 40 m farther win only when it
-  // gains 200 m² more, about a fifth of a typical step's F at α = 0.5 on the campus, so
-  // the robot finishes the area around it before crossing the site, yet still goes far when
-  // nothing near is left.
-  double travel_cost_per_m = 5.0;
+  // travel: score = F − travel_cost_per_m · F_best · path length, where F_best is the best F
+  // of the policy's first look over the region (its lattice sample). A metre of driving thus
+  // costs a fixed share of what the best scan would gain, so the trade keeps its balance as
+  // the gains shrink over a mission (an absolute cost in m²/m that suits the first scans pins
+  // the robot to crumbs near the end). 0.0035: 100 m of driving must buy 35% of the best
+  // gain. On the campus (5 seeds to 95% coverage, docs/benchmarks.md) this drove 0.64× the
+  // path of `paper` for 1.2 scans more; costs from 0.0015 to 0.005 all took 1–2 scans more,
+  // 0.0075 and up stalled on crumbs.
+  double travel_cost_per_m = 0.0035;
   // Candidates in the ranked list lie at least this far apart, so that the operator chooses
   // among different places rather than neighbouring cells of one.
   double candidate_separation_m = 5.0;
@@ -64,13 +68,14 @@ struct PlannerConfig {
 
 struct Candidate {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // x, y, floor z of the scan point B
-  double f = 0;                   // Eq. 1 value
-  double gain_unscanned_m2 = 0;   // area((U∩C_B) ∪ (U∩M_B))
-  double gain_low_res_m2 = 0;     // area(M_A∩C_B)
-  double travel_m = 0;            // path length over the movable region from the robot
+  double f = 0;                                        // Eq. 1 value
+  double gain_unscanned_m2 = 0;                        // area((U∩C_B) ∪ (U∩M_B))
+  double gain_low_res_m2 = 0;                          // area(M_A∩C_B)
+  double travel_m = 0;                // path length over the movable region from the robot
   std::vector<Eigen::Vector2d> path;  // cell centres from the robot to B
-  double score = 0;  // what the policy ranked by: F (paper, exhaustive, random), F − cost·travel
-                     // (travel), −travel (nearest-frontier)
+  // What the policy ranked by: F (paper, exhaustive, random), F − travel_cost_per_m · F_best ·
+  // travel_m (travel), −travel_m (nearest-frontier).
+  double score = 0;
 };
 
 struct PlanInput {

@@ -17,7 +17,7 @@ namespace scanplan {
 // region was flooded with, checked again because two movable neighbours may have been reached
 // by different routes on either side of a step).
 struct TravelMap {
-  CellGrid<float> distance_m;    // the movable region's geometry; +inf where not reachable
+  CellGrid<float> distance_m;     // the movable region's geometry; +inf where not reachable
   CellGrid<std::int32_t> parent;  // offset of the previous cell on the way; -1 at the start
   CellIndex start;
   bool reachable(CellIndex c) const;

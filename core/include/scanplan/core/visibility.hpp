@@ -113,8 +113,8 @@ class VisibilityPredictor {
     std::int16_t n = 0;      // patches; 0 = unknown
     std::int16_t thin = -1;  // index into thin_centres_ when the lowest patch is a thin object
   };
-  struct Trace;      // one call's constants
-  struct RayState;   // what a ray carries outward and hands to the rays it splits into
+  struct Trace;     // one call's constants
+  struct RayState;  // what a ray carries outward and hands to the rays it splits into
   struct Ray {
     Eigen::Vector2f dir;
     std::uint32_t walk_begin, segment_begin, walk_end;  // into steps_
