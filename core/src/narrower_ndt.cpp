@@ -4,7 +4,9 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
@@ -56,13 +58,16 @@ struct Derivatives {
 // Past this Mahalanobis distance a term is below e^-15 of its peak: not worth the work.
 constexpr double kMaxExponent = 30.0;
 
+// The NDT score of a source point set against a grid, with its derivatives.
 template <int N>
 class NdtProblem {
  public:
   NdtProblem(const NdtGrid& grid, const std::vector<Eigen::Vector3d>& source, ScoreShape shape,
              int threads)
-      : grid_(grid), source_(source), shape_(shape), threads_(threads) {}
+      : grid_(grid), source_(source), shape_(shape), threads_(threads), blocks_(source.size()) {}
 
+  // Not thread-safe: each point's block lookup is cached between calls, since from one
+  // evaluation to the next a point rarely leaves its 2×2×2 block.
   template <bool kDerivatives>
   Derivatives<N> evaluate(const Eigen::Isometry3d& T) const {
     Derivatives<N> total;
@@ -70,27 +75,35 @@ class NdtProblem {
 #pragma omp parallel num_threads(threads_)
     {
       Derivatives<N> local;
-      std::array<const NdtCell*, 8> cells;
-      std::array<double, 8> weights;
 #pragma omp for schedule(static) nowait
       for (int i = 0; i < n; ++i) {
         const Eigen::Vector3d p = T * source_[i];
-        const int found = grid_.neighbourhood(p, cells, weights);
-        if (found == 0) continue;
-        ++local.matched;
-        Eigen::Matrix<double, 3, N> J;
+        std::uint64_t key;
+        Eigen::Vector3d f;
+        if (!grid_.block_of(p, key, f)) continue;
+        CachedBlock& block = blocks_[static_cast<std::size_t>(i)];
+        if (block.key != key) {
+          block.key = key;
+          grid_.block_cells(key, block.cells);
+        }
+        bool matched = false;
+        [[maybe_unused]] Eigen::Matrix<double, 3, N> J;
         if constexpr (kDerivatives) J = detail::point_jacobian<N>(p);
-        for (int c = 0; c < found; ++c) {
-          const Eigen::Vector3d q = p - cells[c]->mean;
-          const Eigen::Vector3d w = cells[c]->inverse_covariance * q;
-          const double m = q.dot(w);
-          const double exponent = 0.5 * shape_.d2 * m;
-          if (exponent > kMaxExponent) continue;
+        for (int c = 0; c < 8; ++c) {
+          const NdtCell* cell = block.cells[c];
+          if (!cell) continue;
+          matched = true;
           // Trilinear weights: each point weighs one Gaussian's worth wherever it is. A plain
           // sum over the block would pay points for sitting where more cells exist, pulling the
           // source towards the middle of the target's coverage (metres, on the campus).
           // The weights are held constant in the derivatives, as Magnusson does.
-          const double e = std::exp(-exponent) * weights[c];
+          const double weight = (c & 1 ? f.x() : 1 - f.x()) * (c & 2 ? f.y() : 1 - f.y()) *
+                                (c & 4 ? f.z() : 1 - f.z());
+          const Eigen::Vector3d q = p - cell->mean;
+          const Eigen::Vector3d w = cell->inverse_covariance * q;
+          const double exponent = 0.5 * shape_.d2 * q.dot(w);
+          if (exponent > kMaxExponent) continue;
+          const double e = std::exp(-exponent) * weight;
           local.cost += shape_.d1 * e;
           if constexpr (kDerivatives) {
             // d(cost)/dθ = −d1·d2·e·(wᵀJ); the Hessian adds the curvature of the Mahalanobis
@@ -98,13 +111,13 @@ class NdtProblem {
             const double k = -shape_.d1 * shape_.d2 * e;
             const Eigen::Matrix<double, 1, N> a = w.transpose() * J;
             local.gradient += k * a.transpose();
-            Mat<N> h =
-                J.transpose() * cells[c]->inverse_covariance * J - shape_.d2 * a.transpose() * a;
+            Mat<N> h = J.transpose() * cell->inverse_covariance * J - shape_.d2 * a.transpose() * a;
             h.template bottomRightCorner<N - 3, N - 3>() +=
                 detail::contracted_point_hessian<N>(p, w);
             local.hessian += k * h;
           }
         }
+        local.matched += matched;
       }
 #pragma omp critical
       total.add(local);
@@ -113,10 +126,15 @@ class NdtProblem {
   }
 
  private:
+  struct CachedBlock {
+    std::uint64_t key = ~std::uint64_t{0};
+    std::array<const NdtCell*, 8> cells{};
+  };
   const NdtGrid& grid_;
   const std::vector<Eigen::Vector3d>& source_;
   ScoreShape shape_;
   int threads_;
+  mutable std::vector<CachedBlock> blocks_;
 };
 
 // A descent direction from the Newton system: eigenvalues replaced by their magnitude (and kept
@@ -199,6 +217,45 @@ LevelOutcome optimise_level(const NdtProblem<N>& problem, double cell_m, std::si
   return out;
 }
 
+// The starts tried at the first cell size, best first: every yaw offset × every grid shift,
+// ranked by the NDT cost on a sparse copy of the source, the best `search_keep` kept. With no
+// translation search and few yaw offsets, all of them (no ranking needed).
+template <int N>
+std::vector<Eigen::Isometry3d> hypotheses(const NdtGrid& grid, const PointCloud& source,
+                                          const Eigen::Isometry3d& start, double cell,
+                                          const NdtConfig& config, int threads) {
+  std::vector<double> yaws = config.yaw_hypotheses_deg;
+  if (yaws.empty()) yaws = {0.0};
+  const int k = std::max(config.translation_search_steps, 0);
+  const double step = cell * config.translation_search_step_per_cell;
+  std::vector<Eigen::Isometry3d> all;
+  for (const double yaw : yaws) {
+    for (int ix = -k; ix <= k; ++ix) {
+      for (int iy = -k; iy <= k; ++iy) {
+        Eigen::Isometry3d T = start;
+        T.linear() = Eigen::AngleAxisd(deg2rad(yaw), Eigen::Vector3d::UnitZ()) * start.linear();
+        T.translation() += Eigen::Vector3d(ix * step, iy * step, 0);
+        all.push_back(T);
+      }
+    }
+  }
+  const std::size_t keep = static_cast<std::size_t>(std::max(config.search_keep, 1));
+  if (all.size() <= keep) return all;
+  const PointCloud sparse = voxel_downsample(source, cell * config.search_voxel_per_cell);
+  std::vector<Eigen::Vector3d> points;
+  for (const auto& p : sparse.points) points.push_back(p.cast<double>());
+  const NdtProblem<N> screen(grid, points, ScoreShape(config.outlier_ratio, cell), threads);
+  std::vector<std::pair<double, std::size_t>> ranked;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    ranked.emplace_back(screen.template evaluate<false>(all[i]).cost, i);
+  }
+  std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(keep),
+                    ranked.end());
+  std::vector<Eigen::Isometry3d> best;
+  for (std::size_t i = 0; i < keep; ++i) best.push_back(all[ranked[i].second]);
+  return best;
+}
+
 template <int N>
 RegistrationResult align(const PointCloud& target, const PointCloud& source,
                          const Eigen::Isometry3d& initial, const NdtConfig& config) {
@@ -227,19 +284,23 @@ RegistrationResult align(const PointCloud& target, const PointCloud& source,
     points.reserve(thinned.size());
     for (const auto& p : thinned.points) points.push_back(p.cast<double>());
     const NdtProblem<N> problem(grid, points, ScoreShape(config.outlier_ratio, cell), threads);
-    // At the first cell size the match also starts from yaw hypotheses around the initial
-    // guess, turned about the source's origin; the one that ends at the lowest cost goes on.
-    const std::vector<double> yaws = level == 0 && !config.yaw_hypotheses_deg.empty()
-                                         ? config.yaw_hypotheses_deg
-                                         : std::vector<double>{0.0};
+    // At the first cell size the match also starts from hypotheses around the initial guess:
+    // turned by the yaw offsets about the source's origin and, when a translation search is
+    // configured, shifted on a grid; a cheap score on a sparse source ranks them and the best
+    // few are optimised. The one that ends at the lowest cost goes on.
     const Eigen::Isometry3d start = result.transform;
+    std::vector<Eigen::Isometry3d> starts;
+    if (level == 0) {
+      starts = hypotheses<N>(grid, source, start, cell, config, threads);
+    } else {
+      starts = {start};
+    }
     // Each hypothesis gets a few steps only; the best of them then runs to convergence.
     NdtConfig trial_config = config;
-    if (yaws.size() > 1) trial_config.max_iterations = config.hypothesis_iterations;
+    if (starts.size() > 1) trial_config.max_iterations = config.hypothesis_iterations;
     LevelOutcome outcome;
-    for (std::size_t h = 0; h < yaws.size(); ++h) {
-      Eigen::Isometry3d T = start;
-      T.linear() = Eigen::AngleAxisd(deg2rad(yaws[h]), Eigen::Vector3d::UnitZ()) * start.linear();
+    for (std::size_t h = 0; h < starts.size(); ++h) {
+      Eigen::Isometry3d T = starts[h];
       const LevelOutcome trial = optimise_level<N>(problem, cell, points.size(), trial_config, T);
       result.iterations += trial.iterations;
       const bool better =
@@ -249,7 +310,7 @@ RegistrationResult align(const PointCloud& target, const PointCloud& source,
         result.transform = T;
       }
     }
-    if (yaws.size() > 1 && outcome.failure.empty() && !outcome.converged) {
+    if (starts.size() > 1 && outcome.failure.empty() && !outcome.converged) {
       outcome = optimise_level<N>(problem, cell, points.size(), config, result.transform);
       result.iterations += outcome.iterations;
     }

@@ -99,7 +99,10 @@ bool NdtGrid::key_of(const Eigen::Vector3d& p, std::int64_t (&c)[3]) const {
 
 const NdtCell* NdtGrid::find(std::int64_t x, std::int64_t y, std::int64_t z) const {
   if (!in_range(x) || !in_range(y) || !in_range(z)) return nullptr;
-  const std::uint64_t key = pack(x, y, z);
+  return find_key(pack(x, y, z));
+}
+
+const NdtCell* NdtGrid::find_key(std::uint64_t key) const {
   for (std::uint64_t s = slot_hash(key) >> 20 & slot_mask_;; s = (s + 1) & slot_mask_) {
     const std::int32_t c = slot_cells_[s];
     if (c < 0) return nullptr;
@@ -112,26 +115,42 @@ const NdtCell* NdtGrid::cell_at(const Eigen::Vector3d& p) const {
   return key_of(p, c) ? find(c[0], c[1], c[2]) : nullptr;
 }
 
-int NdtGrid::neighbourhood(const Eigen::Vector3d& p, std::array<const NdtCell*, 8>& out,
-                           std::array<double, 8>& weight) const {
+bool NdtGrid::block_of(const Eigen::Vector3d& p, std::uint64_t& key,
+                       Eigen::Vector3d& fraction) const {
   // Shifting by half a cell makes floor() give the lower corner of the 2×2×2 block whose
   // centres surround p.
   const Eigen::Vector3d shifted = p - Eigen::Vector3d::Constant(0.5 * cell_m_);
   std::int64_t c[3];
-  if (!key_of(shifted, c)) return 0;
+  if (!key_of(shifted, c)) return false;
+  for (int a = 0; a < 3; ++a) {
+    if (!in_range(c[a] + 1)) return false;  // the block's far corner must pack too
+    fraction[a] = shifted[a] * inv_cell_ - static_cast<double>(c[a]);
+  }
+  key = pack(c[0], c[1], c[2]);
+  return true;
+}
+
+void NdtGrid::block_cells(std::uint64_t key, std::array<const NdtCell*, 8>& out) const {
+  // Packing is linear in each coordinate, so the neighbours' keys are offsets of the corner's.
+  constexpr std::uint64_t kY = std::uint64_t{1} << 21, kZ = std::uint64_t{1} << 42;
+  for (int k = 0; k < 8; ++k) {
+    out[k] = find_key(key + (k & 1) + ((k >> 1) & 1) * kY + ((k >> 2) & 1) * kZ);
+  }
+}
+
+int NdtGrid::neighbourhood(const Eigen::Vector3d& p, std::array<const NdtCell*, 8>& out,
+                           std::array<double, 8>& weight) const {
+  std::uint64_t key;
   Eigen::Vector3d f;
-  for (int a = 0; a < 3; ++a) f[a] = shifted[a] * inv_cell_ - static_cast<double>(c[a]);
+  if (!block_of(p, key, f)) return 0;
+  std::array<const NdtCell*, 8> block;
+  block_cells(key, block);
   int n = 0;
-  for (int dz = 0; dz < 2; ++dz) {
-    for (int dy = 0; dy < 2; ++dy) {
-      for (int dx = 0; dx < 2; ++dx) {
-        if (const NdtCell* cell = find(c[0] + dx, c[1] + dy, c[2] + dz)) {
-          weight[n] =
-              (dx ? f.x() : 1 - f.x()) * (dy ? f.y() : 1 - f.y()) * (dz ? f.z() : 1 - f.z());
-          out[n++] = cell;
-        }
-      }
-    }
+  for (int k = 0; k < 8; ++k) {
+    if (!block[k]) continue;
+    weight[n] =
+        (k & 1 ? f.x() : 1 - f.x()) * (k & 2 ? f.y() : 1 - f.y()) * (k & 4 ? f.z() : 1 - f.z());
+    out[n++] = block[k];
   }
   return n;
 }

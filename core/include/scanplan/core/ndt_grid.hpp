@@ -46,9 +46,16 @@ class NdtGrid {
   int neighbourhood(const Eigen::Vector3d& p, std::array<const NdtCell*, 8>& out,
                     std::array<double, 8>& weight) const;
 
+  // The same in two steps, for callers that cache the lookups: the block around p (its key and
+  // p's position inside it, each coordinate in [0, 1)), and the cells of a block (null where a
+  // cell has no Gaussian), in the order z, y, x with x fastest. block_of is false out of range.
+  bool block_of(const Eigen::Vector3d& p, std::uint64_t& key, Eigen::Vector3d& fraction) const;
+  void block_cells(std::uint64_t key, std::array<const NdtCell*, 8>& out) const;
+
  private:
   bool key_of(const Eigen::Vector3d& p, std::int64_t (&c)[3]) const;
   const NdtCell* find(std::int64_t x, std::int64_t y, std::int64_t z) const;
+  const NdtCell* find_key(std::uint64_t key) const;
 
   double cell_m_;
   double inv_cell_;
