@@ -17,14 +17,8 @@
 namespace scanplan {
 namespace {
 
-// "1.25 m": lengths in messages, to three significant digits.
-std::string metres(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g m", v);
-  return buf;
-}
-
 using detail::Mat;
+using detail::metres;
 using detail::Vec;
 
 // The constants of the Gaussian score (Magnusson 2009 eq. 6.8): a mixture of a normal

@@ -10,11 +10,20 @@
 
 #include <Eigen/Geometry>
 #include <array>
+#include <cstdio>
+#include <string>
 #include <utility>
 
 #include "scanplan/core/registration_result.hpp"
 
 namespace scanplan::detail {
+
+// "1.25 m": lengths in messages, to three significant digits.
+inline std::string metres(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g m", v);
+  return buf;
+}
 
 template <int N>
 using Vec = Eigen::Matrix<double, N, 1>;
