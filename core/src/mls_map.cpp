@@ -73,7 +73,9 @@ std::optional<std::pair<CellIndex, CellIndex>> MlsMap::extent() const {
   return std::make_pair(min_, max_);
 }
 
-InsertStats MlsMap::insert(const PointCloud& cloud) { return insert(cloud.points); }
+InsertStats MlsMap::insert(const PointCloud& cloud) {
+  return insert(cloud.points);
+}
 
 InsertStats MlsMap::insert(const std::vector<Eigen::Vector3f>& points) {
   InsertStats stats;
@@ -93,7 +95,12 @@ InsertStats MlsMap::insert(const std::vector<Eigen::Vector3f>& points) {
 }
 
 void MlsMap::insert_point(const Eigen::Vector3f& p, Tile*& cached, std::uint64_t& cached_key) {
-  add_to_cell(touch(index_of(p.x(), p.y()), cached, cached_key), p.z());
+  MlsCell& c = touch(index_of(p.x(), p.y()), cached, cached_key);
+  if (c.interpolated) {
+    c.size = 0;
+    c.interpolated = false;
+  }
+  add_to_cell(c, p.z());
 }
 
 MlsCell& MlsMap::touch(CellIndex c, Tile*& cached, std::uint64_t& cached_key) {
@@ -168,7 +175,9 @@ void MlsMap::fill_between(const Eigen::Vector3f& a, const Eigen::Vector3f& b, Ti
     // Only cells the laser saw nothing in: measured surfaces keep their own statistics.
     const MlsCell* existing = cell(c);
     if (existing) continue;
-    add_to_cell(touch(c, cached, cached_key), p.z());
+    MlsCell& filled = touch(c, cached, cached_key);
+    add_to_cell(filled, p.z());
+    filled.interpolated = true;
   }
 }
 
@@ -199,8 +208,8 @@ void MlsMap::add_to_cell(MlsCell& cell, float z) {
   if (n == MlsCell::kMaxPatches) {
     // No room for another surface: fold the point into the nearer neighbouring patch.
     const int below = at - 1, above = at < n ? at : -1;
-    const int k = (above < 0 || (below >= 0 && z - ps[below].max_z < ps[above].min_z - z)) ? below
-                                                                                           : above;
+    const int k =
+        (above < 0 || (below >= 0 && z - ps[below].max_z < ps[above].min_z - z)) ? below : above;
     ps[k].add(z);
     return;
   }

@@ -61,6 +61,7 @@ void check_config(const PlannerConfig& c) {
   if (!(c.lattice_m > 0)) fail("lattice_m must be greater than zero");
   if (c.max_candidates < 1) fail("max_candidates must be at least 1");
   if (!(c.travel_cost_per_m >= 0)) fail("travel_cost_per_m must be zero or more");
+  if (!(c.travel_free_m >= 0)) fail("travel_free_m must be zero or more");
   if (!(c.candidate_separation_m >= 0)) fail("candidate_separation_m must be zero or more");
   if (!std::isfinite(c.min_gain_m2)) fail("min_gain_m2 must be finite");
   if (c.threads < 0) fail("threads must be zero (OpenMP default) or more");
@@ -460,13 +461,15 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
       break;
     }
     case PlannerPolicy::kTravel: {
-      // A metre of driving costs travel_cost_per_m of the best F in view, so the trade keeps
-      // its balance as the gains shrink over a mission. The drive is smooth over the region,
-      // so the traded score is climbed as F is.
+      // A metre of driving beyond travel_free_m costs travel_cost_per_m of the best F in view,
+      // so the trade keeps its balance as the gains shrink over a mission. The drive is smooth
+      // over the region, so the traded score is climbed as F is.
       const ScorerFor traded = [&](double best_f) -> Scorer {
         const double per_m = cfg.travel_cost_per_m * best_f;
-        return [&sites, per_m](std::int32_t site, const ScanGain& g) {
-          return g.f - per_m * sites.travel_m[static_cast<std::size_t>(site)];
+        const double free_m = cfg.travel_free_m;
+        return [&sites, per_m, free_m](std::int32_t site, const ScanGain& g) {
+          const double drive = sites.travel_m[static_cast<std::size_t>(site)];
+          return g.f - per_m * std::max(0.0, drive - free_m);
         };
       };
       chosen = rank(hill_climb(gain, sites, cfg, cell_m, threads, traded, plan.evaluations), sites,

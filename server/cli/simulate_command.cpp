@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "scanplan/core/closed_loop.hpp"
+#include "scanplan/core/coverage_chart.hpp"
 #include "scanplan/core/plan_view.hpp"
 
 namespace scanplan::cli {
@@ -65,6 +66,22 @@ void run_simulate(const SimulateArgs& a) {
   };
   const LoopResult r = run_closed_loop(world, config, on_step);
 
+  ChartSeries coverage{a.policy, cv::Scalar(180, 100, 30), {{}}}, detected = coverage;
+  for (const auto& s : r.steps) {
+    coverage.runs[0].push_back(s.coverage_pct);
+    detected.runs[0].push_back(s.detected_m2);
+  }
+  ChartStyle coverage_style, detected_style;
+  coverage_style.title = "scan-completed reachable ground";
+  coverage_style.y_label = "coverage (%)";
+  coverage_style.references = {{95, "95 %"}};
+  detected_style.title = "detected area (C + M)";
+  detected_style.y_label = "area (m2)";
+  cv::Mat chart;
+  cv::hconcat(render_coverage_chart({coverage}, coverage_style),
+              render_coverage_chart({detected}, detected_style), chart);
+  cv::imwrite((out / "coverage.png").string(), chart);
+
   double plan_ms = 0;
   int plans = 0;
   for (const auto& s : r.steps) {
@@ -109,7 +126,8 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--match", args->match, "scan matching of each scan against the map (on|off)")
       ->capture_default_str()
       ->check(CLI::IsMember({"on", "off"}));
-  cmd->add_option("--out", args->out, "output folder (coverage.csv, step_NN.png, summary.json)")
+  cmd->add_option("--out", args->out,
+                  "output folder (coverage.csv, coverage.png, step_NN.png, summary.json)")
       ->required();
   cmd->callback([args] { run_simulate(*args); });
 }

@@ -316,6 +316,7 @@ json params_json(const MissionParams& p) {
           {"policy", std::string(policy_name(p.planner.policy))},
           {"max_candidates", p.planner.max_candidates},
           {"travel_cost_per_m", p.planner.travel_cost_per_m},
+          {"travel_free_m", p.planner.travel_free_m},
           {"completed_radius_m", p.planner.regions.completed_radius_m},
           {"max_step_m", p.planner.movable.max_step_m},
           {"target", target}};
@@ -394,6 +395,8 @@ Response Api::put_params(const Request& request) {
       p.planner.max_candidates = static_cast<int>(number_in(body, "max_candidates", 1, 50));
     } else if (key == "travel_cost_per_m") {
       p.planner.travel_cost_per_m = number_in(body, "travel_cost_per_m", 0, 1e6);
+    } else if (key == "travel_free_m") {
+      p.planner.travel_free_m = number_in(body, "travel_free_m", 0, 1e5);
     } else if (key == "completed_radius_m") {
       p.planner.regions.completed_radius_m = number_in(body, "completed_radius_m", 1, 200);
     } else if (key == "max_step_m") {

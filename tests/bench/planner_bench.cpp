@@ -7,24 +7,31 @@
 // unknown cells and the same gap filling, so the two must agree and only the cost differs.
 // Prints one JSON line. Usage: planner_bench [WORLD.json] [STEPS]
 //
-// planner_bench --travel-vs-paper SEEDS [WORLD.json]: the closed loop (run_closed_loop) with
-// `paper` and with `travel` until 95% of the reachable ground is scan-completed, SEEDS seeds
-// each, poses exact and matching off so that only the planning differs; scans and path to
-// 95% and the area detected after 13 scans, mean and sd. Prints one JSON line.
+// planner_bench --coverage SEEDS POLICIES [WORLD.json] [MAX_SCANS] [PLOT.png]: the closed loop
+// (run_closed_loop) with each policy of the comma-separated list until 95% of the reachable
+// ground is scan-completed (or MAX_SCANS, 60), SEEDS seeds each, poses exact and matching off
+// so that only the planning differs; scans and path to 95% and the area detected after 13
+// scans, mean and sd, and every run's curves. Prints one JSON line; PLOT.png charts coverage,
+// detected area and path against scans. --travel-cost X / --travel-free M set the travel
+// policy's trade.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "scanplan/core/closed_loop.hpp"
+#include "scanplan/core/coverage_chart.hpp"
 #include "scanplan/core/mls_map.hpp"
 #include "scanplan/core/scan_planner.hpp"
 #include "scanplan/core/simulated_scanner.hpp"
+#include "scanplan/core/top_view.hpp"
 #include "scanplan/core/visibility.hpp"
 #include "scanplan/core/world_traversability.hpp"
 
@@ -177,40 +184,125 @@ nlohmann::json mean_sd(const std::vector<double>& v) {
       {"mean", m}, {"sd", v.size() > 1 ? std::sqrt(s2 / (v.size() - 1)) : 0.0}, {"n", v.size()}};
 }
 
-int travel_vs_paper(int seeds, const std::string& world_file) {
+// Splits "paper,travel" into policies; throws for an unknown name.
+std::vector<PlannerPolicy> parse_policies(const std::string& list) {
+  std::vector<PlannerPolicy> out;
+  std::size_t begin = 0;
+  while (begin <= list.size()) {
+    const std::size_t end = std::min(list.find(',', begin), list.size());
+    const std::string name = list.substr(begin, end - begin);
+    const auto p = parse_policy(name);
+    if (!p) throw std::invalid_argument("unknown policy '" + name + "'");
+    out.push_back(*p);
+    begin = end + 1;
+  }
+  return out;
+}
+
+// A colour per policy for the charts (BGR).
+cv::Scalar policy_color(PlannerPolicy p) {
+  switch (p) {
+    case PlannerPolicy::kPaper:
+      return {180, 100, 30};
+    case PlannerPolicy::kExhaustive:
+      return {40, 40, 200};
+    case PlannerPolicy::kTravel:
+      return {60, 160, 40};
+    case PlannerPolicy::kNearestFrontier:
+      return {0, 140, 230};
+    case PlannerPolicy::kRandom:
+      return {140, 140, 140};
+  }
+  return {0, 0, 0};
+}
+
+int coverage_study(int seeds, const std::string& policies, const std::string& world_file,
+                   int max_scans, const std::string& png, const PlannerConfig& travel) {
+  std::vector<ChartSeries> coverage_series, detected_series, path_series;
   World world = load_world(world_file);
   world.pose_noise = PoseNoise{0, 0, 0};
-  nlohmann::json out = {{"bench", "planner_travel_vs_paper"}, {"seeds", seeds}};
-  for (const PlannerPolicy p : {PlannerPolicy::kPaper, PlannerPolicy::kTravel}) {
+  nlohmann::json out = {{"bench", "planner_coverage"},
+                        {"seeds", seeds},
+                        {"max_scans", max_scans},
+                        {"travel_cost_per_m", travel.travel_cost_per_m},
+                        {"travel_free_m", travel.travel_free_m}};
+  for (const PlannerPolicy p : parse_policies(policies)) {
     std::vector<double> scans, path, detected13, plan_ms;
+    nlohmann::json curves = nlohmann::json::array();
+    const std::string name(policy_name(p));
+    coverage_series.push_back({name, policy_color(p), {}});
+    detected_series.push_back({name, policy_color(p), {}});
+    path_series.push_back({name, policy_color(p), {}});
     int reached = 0;
     for (int seed = 1; seed <= seeds; ++seed) {
       ClosedLoopConfig cfg;
       cfg.planner.policy = p;
       cfg.planner.seed = static_cast<std::uint64_t>(seed);
       cfg.planner.visibility = VisibilityConfig::from_scanner(world.scanner);
+      cfg.planner.travel_cost_per_m = travel.travel_cost_per_m;
+      cfg.planner.travel_free_m = travel.travel_free_m;
       cfg.seed = static_cast<std::uint64_t>(seed);
-      cfg.max_scans = 50;
+      cfg.max_scans = max_scans;
       cfg.stop_at_coverage_pct = 95.0;
       cfg.matching.reset();
       double d13 = 0, ms = 0;
+      nlohmann::json curve = {{"seed", seed},
+                              {"detected_m2", nlohmann::json::array()},
+                              {"coverage_pct", nlohmann::json::array()},
+                              {"path_m", nlohmann::json::array()}};
       const LoopResult r =
           run_closed_loop(world, cfg, [&](const LoopStep& s, const MappingPipeline&) {
             if (s.scan == 13) d13 = s.detected_m2;
             ms += s.plan_ms;
+            curve["detected_m2"].push_back(s.detected_m2);
+            curve["coverage_pct"].push_back(s.coverage_pct);
+            curve["path_m"].push_back(s.path_m);
           });
+      curve["stopped_because"] = r.stopped_because;
+      coverage_series.back().runs.push_back(curve["coverage_pct"].get<std::vector<double>>());
+      detected_series.back().runs.push_back(curve["detected_m2"].get<std::vector<double>>());
+      path_series.back().runs.push_back(curve["path_m"].get<std::vector<double>>());
+      curves.push_back(curve);
       detected13.push_back(d13);
       plan_ms.push_back(ms / r.steps.size());
+      std::fprintf(stderr, "%s seed %d: %s scans to 95%%, path %.0f m\n",
+                   std::string(policy_name(p)).c_str(), seed,
+                   r.scans_to_95pct ? std::to_string(*r.scans_to_95pct).c_str() : "no",
+                   r.path_to_95pct_m.value_or(0.0));
       if (!r.scans_to_95pct) continue;
       ++reached;
       scans.push_back(*r.scans_to_95pct);
       path.push_back(*r.path_to_95pct_m);
     }
-    out[std::string(policy_name(p))] = {{"reached_95pct", reached},
-                                        {"scans_to_95pct", mean_sd(scans)},
-                                        {"path_to_95pct_m", mean_sd(path)},
-                                        {"detected_after_13_m2", mean_sd(detected13)},
-                                        {"plan_ms", mean_sd(plan_ms)}};
+    out[std::string(policy_name(p))] = {
+        {"reached_95pct", reached},         {"scans_to_95pct", mean_sd(scans)},
+        {"path_to_95pct_m", mean_sd(path)}, {"detected_after_13_m2", mean_sd(detected13)},
+        {"plan_ms", mean_sd(plan_ms)},      {"curves", curves}};
+  }
+  if (!png.empty()) {
+    ChartStyle coverage_style, detected_style, path_style;
+    coverage_style.title = "scan-completed reachable ground, mean +- sd";
+    coverage_style.y_label = "coverage (%)";
+    coverage_style.references = {{95, "95 %"}};
+    detected_style.title = "detected area (C + M), mean +- sd";
+    detected_style.y_label = "area (m2)";
+    detected_style.references = {{16500, "paper: 16,500 m2 in 13 scans"}};
+    path_style.width_px = 2 * coverage_style.width_px;
+    path_style.height_px = 300;
+    path_style.title = "path driven, mean +- sd";
+    path_style.y_label = "path (m)";
+    cv::Mat row1, chart;
+    cv::hconcat(render_coverage_chart(coverage_series, coverage_style),
+                render_coverage_chart(detected_series, detected_style), row1);
+    cv::vconcat(row1, render_coverage_chart(path_series, path_style), chart);
+    const auto bytes = encode_png(chart);
+    std::FILE* f = std::fopen(png.c_str(), "wb");
+    if (!f || std::fwrite(bytes.data(), 1, bytes.size(), f) != bytes.size()) {
+      std::fprintf(stderr, "cannot write %s\n", png.c_str());
+      return 1;
+    }
+    std::fclose(f);
+    out["png"] = png;
   }
   std::printf("%s\n", out.dump().c_str());
   return 0;
@@ -219,9 +311,24 @@ int travel_vs_paper(int seeds, const std::string& world_file) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc > 2 && std::string(argv[1]) == "--travel-vs-paper") {
-    return travel_vs_paper(std::stoi(argv[2]),
-                           argc > 3 ? argv[3] : SCANPLAN_SOURCE_DIR "/samples/worlds/campus.json");
+  if (argc > 3 && std::string(argv[1]) == "--coverage") {
+    // --travel-cost X and --travel-free M anywhere after the policies override the defaults.
+    PlannerConfig travel;
+    std::vector<std::string> rest;
+    for (int i = 4; i < argc; ++i) {
+      const std::string a = argv[i];
+      if (a == "--travel-cost" && i + 1 < argc) {
+        travel.travel_cost_per_m = std::stod(argv[++i]);
+      } else if (a == "--travel-free" && i + 1 < argc) {
+        travel.travel_free_m = std::stod(argv[++i]);
+      } else {
+        rest.push_back(a);
+      }
+    }
+    return coverage_study(
+        std::stoi(argv[2]), argv[3],
+        rest.size() > 0 ? rest[0] : SCANPLAN_SOURCE_DIR "/samples/worlds/campus.json",
+        rest.size() > 1 ? std::stoi(rest[1]) : 60, rest.size() > 2 ? rest[2] : "", travel);
   }
   const std::string world_file =
       argc > 1 ? argv[1] : SCANPLAN_SOURCE_DIR "/samples/worlds/campus.json";

@@ -26,9 +26,12 @@ std::vector<Eigen::Vector3f> slab(int x0, int x1, int y0, int y1, float z, int p
 
 TEST(MlsMap, PatchesSplitAtGapsTallerThanTheRobot) {
   MlsMap map;  // robot 1.5 m
-  map.insert(std::vector<Eigen::Vector3f>{{0.5f, 0.5f, 0.0f}, {0.5f, 0.5f, 0.02f},  // ground
-                                          {0.5f, 0.5f, 3.0f}, {0.5f, 0.5f, 3.4f},   // canopy
-                                          {1.5f, 0.5f, 0.0f}, {1.5f, 0.5f, 1.0f},   // a 1 m box
+  map.insert(std::vector<Eigen::Vector3f>{{0.5f, 0.5f, 0.0f},
+                                          {0.5f, 0.5f, 0.02f},  // ground
+                                          {0.5f, 0.5f, 3.0f},
+                                          {0.5f, 0.5f, 3.4f},  // canopy
+                                          {1.5f, 0.5f, 0.0f},
+                                          {1.5f, 0.5f, 1.0f},  // a 1 m box
                                           {1.5f, 0.5f, 0.5f}});
   const MlsCell* tree = map.cell({0, 0});
   ASSERT_NE(tree, nullptr);
@@ -72,9 +75,12 @@ TEST(MlsMap, NonFinitePointsAreRefusedAndTheMapStaysIntact) {
   map.insert(slab(0, 3, 0, 3, 0.0f));
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float inf = std::numeric_limits<float>::infinity();
-  const InsertStats st = map.insert(std::vector<Eigen::Vector3f>{
-      {nan, 0.5f, 0.0f}, {0.5f, inf, 0.0f}, {0.5f, 0.5f, nan}, {0.5f, 0.5f, -inf}, {1e30f, 0, 0},
-      {1.5f, 1.5f, 0.01f}});
+  const InsertStats st = map.insert(std::vector<Eigen::Vector3f>{{nan, 0.5f, 0.0f},
+                                                                 {0.5f, inf, 0.0f},
+                                                                 {0.5f, 0.5f, nan},
+                                                                 {0.5f, 0.5f, -inf},
+                                                                 {1e30f, 0, 0},
+                                                                 {1.5f, 1.5f, 0.01f}});
   EXPECT_EQ(st.rejected, 5u);
   EXPECT_EQ(st.inserted, 1u);
   EXPECT_EQ(map.occupied_cells(), 9u);
@@ -114,8 +120,8 @@ TEST(RegionSegmentation, PolygonTargetCountsOnlyCellsWhoseCentreIsInside) {
 
 TEST(MovableRegion, StepIsNotCrossedButARampIs) {
   MlsMap map;
-  map.insert(slab(0, 10, 0, 10, 0.0f));    // lower ground
-  map.insert(slab(10, 20, 0, 5, 0.2f));    // a 0.2 m step up along x
+  map.insert(slab(0, 10, 0, 10, 0.0f));  // lower ground
+  map.insert(slab(10, 20, 0, 5, 0.2f));  // a 0.2 m step up along x
   // A ramp from 0 to 0.2 m over x 10..13 along y 5..10 (0.067 m per cell), then the plaza.
   for (int x = 10; x < 13; ++x) map.insert(slab(x, x + 1, 5, 10, 0.2f * (x - 9) / 3.0f));
   map.insert(slab(13, 20, 5, 10, 0.2f));
@@ -178,6 +184,34 @@ TEST(MlsMap, FillingBetweenBeamsClosesTheRingsOfFarGround) {
   }
   EXPECT_LT(plain_cells, 20u);
   EXPECT_EQ(filled_cells, 28u);
+}
+
+TEST(MlsMap, AMeasurementReplacesTheHeightsInterpolatedBetweenBeams) {
+  // Two returns of one fan, 10 m and 14 m out: the ground between them is interpolated, rising
+  // from -1 m to -0.2 m as it would towards the top of a low wall.
+  PointCloud fan;
+  fan.points = {{10.2f, 0.51f, -1.0f}, {14.2f, 0.71f, -0.2f}};  // one azimuth
+  MlsMap map;
+  map.insert_scan(fan, Eigen::Isometry3d::Identity(), Eigen::Vector3d::Zero());
+  const MlsCell* guessed = map.cell({12, 0});
+  ASSERT_NE(guessed, nullptr);
+  EXPECT_TRUE(guessed->interpolated);
+  EXPECT_NEAR(guessed->patches[0].mean_z, -0.6f, 0.15f);
+  // A later scan measures the real ground there, 0.4 m below the guess: the cell becomes that
+  // ground alone, one thin patch, not a 0.4 m deep mix that is no floor.
+  map.insert(std::vector<Eigen::Vector3f>{{12.5f, 0.5f, -1.0f}, {12.7f, 0.2f, -1.01f}});
+  const MlsCell* measured = map.cell({12, 0});
+  ASSERT_NE(measured, nullptr);
+  EXPECT_FALSE(measured->interpolated);
+  ASSERT_EQ(measured->size, 1);
+  EXPECT_EQ(measured->patches[0].count, 2u);
+  EXPECT_NEAR(measured->patches[0].extent(), 0.01f, 1e-4f);
+  // Interpolated cells never overwrite measured ones, and measured ones are never reset.
+  map.insert_scan(fan, Eigen::Isometry3d::Identity(), Eigen::Vector3d::Zero());
+  EXPECT_EQ(map.cell({12, 0})->patches[0].count, 2u);
+  map.insert(std::vector<Eigen::Vector3f>{{12.5f, 0.5f, -0.99f}});
+  EXPECT_EQ(map.cell({12, 0})->patches[0].count, 3u);
+  EXPECT_TRUE(map.cell({11, 0})->interpolated);
 }
 
 TEST(TopView, LayersHaveTheTargetsShapeAndColours) {

@@ -176,10 +176,16 @@ TEST_F(WallYard, TravelTradesGainForDistance) {
   EXPECT_GE(free_travel.f, 0.98 * best.f) << "with driving free, travel climbs F as paper does";
   EXPECT_DOUBLE_EQ(free_travel.score, free_travel.f);
   cfg.travel_cost_per_m = 0.1;  // 10 m of driving cost the best scan's whole gain
+  cfg.travel_free_m = 0;
   const Candidate near = plan_next_scan(input(), cfg).ranked.front();
   EXPECT_LT(near.travel_m, 5.0);
   EXPECT_LE(near.score, near.f);
   EXPECT_GT(near.f, 0);
+  // Within the free radius only F counts: the far best point again.
+  cfg.travel_free_m = best.travel_m + 1;
+  const Candidate within = plan_next_scan(input(), cfg).ranked.front();
+  EXPECT_GE(within.f, 0.98 * best.f);
+  EXPECT_DOUBLE_EQ(within.score, within.f);
 }
 
 TEST_F(WallYard, EvaluateAgreesWithThePlan) {

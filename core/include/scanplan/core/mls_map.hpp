@@ -50,6 +50,11 @@ struct MlsCell {
   static constexpr int kMaxPatches = 4;
   std::array<SurfacePatch, kMaxPatches> patches{};
   std::uint8_t size = 0;
+  // Every height here was interpolated between two beams (MlsConfig::fill_between_beams), none
+  // measured. The first measured point replaces them: interpolation across the foot of a wall
+  // leaves a slope that is not there, and folded into the real ground it would make the cell
+  // one deep patch instead of a floor.
+  bool interpolated = false;
 
   bool empty() const { return size == 0; }
   const SurfacePatch* begin() const { return patches.data(); }

@@ -44,15 +44,18 @@ struct PlannerConfig {
   int hill_climb_samples = 1024;
   double lattice_m = 1.0;  // exhaustive: candidate spacing, in whole cells
   int max_candidates = 5;  // ranked list length
-  // travel: score = F − travel_cost_per_m · F_best · path length, where F_best is the best F
-  // of the policy's first look over the region (its lattice sample). A metre of driving thus
-  // costs a fixed share of what the best scan would gain, so the trade keeps its balance as
-  // the gains shrink over a mission (an absolute cost in m²/m that suits the first scans pins
-  // the robot to crumbs near the end). 0.0035: 100 m of driving must buy 35% of the best
-  // gain. On the campus (5 seeds to 95% coverage, docs/benchmarks.md) this drove 0.64× the
-  // path of `paper` for 1.2 scans more; costs from 0.0015 to 0.005 all took 1–2 scans more,
-  // 0.0075 and up stalled on crumbs.
+  // travel: score = F − travel_cost_per_m · F_best · max(0, drive − travel_free_m), where
+  // F_best is the best F of the policy's first look over the region (its lattice sample).
+  // Scans within travel_free_m of driving compete on F alone, as in `paper`; what the trade
+  // removes is the long drive across the site to a scan hardly better than one nearby. A metre
+  // beyond that costs a fixed share of what the best scan would gain, so the trade keeps its
+  // balance as the gains shrink over a mission (an absolute cost in m²/m that suits the first
+  // scans pins the robot to crumbs near the end). Chosen on the campus, 5 seeds to 95%
+  // coverage (docs/benchmarks.md): a cost from the first metre (free 0) drove 0.64× the path
+  // of `paper` for 1.2 scans more; a free radius of 60 m keeps the scans and most of the
+  // saving.
   double travel_cost_per_m = 0.0035;
+  double travel_free_m = 60.0;
   // Candidates in the ranked list lie at least this far apart, so that the operator chooses
   // among different places rather than neighbouring cells of one.
   double candidate_separation_m = 5.0;
@@ -74,7 +77,7 @@ struct Candidate {
   double travel_m = 0;                // path length over the movable region from the robot
   std::vector<Eigen::Vector2d> path;  // cell centres from the robot to B
   // What the policy ranked by: F (paper, exhaustive, random), F − travel_cost_per_m · F_best ·
-  // travel_m (travel), −travel_m (nearest-frontier).
+  // max(0, travel_m − travel_free_m) (travel), −travel_m (nearest-frontier).
   double score = 0;
 };
 
