@@ -10,6 +10,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libpcl-dev libnanoflann-dev
   nodejs npm chromium
 )
+# Benchmarks only (tests/bench/http_bench.sh): the load generator and the baseline server.
+[ "${1:-}" = "--bench" ] && packages+=(wrk nginx-light)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -88,6 +88,12 @@ void run_simulate(const SimulateArgs& a) {
     if (s.plan_ms > 0) plan_ms += s.plan_ms, ++plans;
   }
   const LoopStep& last = r.steps.back();
+  // Where each scan was really taken (x, y, z, yaw_deg): to take the same scans again, e.g.
+  // with `scanplan scan` for a server benchmark.
+  nlohmann::json true_poses = nlohmann::json::array();
+  for (const auto& s : r.steps) {
+    true_poses.push_back({s.true_pose.x, s.true_pose.y, s.true_pose.z, rad2deg(s.true_pose.yaw)});
+  }
   const nlohmann::json summary = {
       {"world", world.name},
       {"policy", a.policy},
@@ -105,6 +111,7 @@ void run_simulate(const SimulateArgs& a) {
       {"path_to_95pct_m", optional_json(r.path_to_95pct_m)},
       {"mean_plan_ms", plans ? plan_ms / plans : 0.0},
       {"stopped", r.stopped_because},
+      {"true_poses", true_poses},
       {"out", out.string()}};
   std::ofstream(out / "summary.json") << summary.dump(2) << "\n";
   std::cout << summary.dump() << std::endl;

@@ -141,6 +141,11 @@ void HttpServer::start() {
     // Lets a restarted server rebind while old connections sit in TIME_WAIT.
     const int one = 1;
     ::setsockopt(fd.get(), SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one));
+    if (config_.reuse_port &&
+        ::setsockopt(fd.get(), SOL_SOCKET, SO_REUSEPORT, &one, sizeof(one)) != 0) {
+      last_error = errno;
+      continue;
+    }
     if (::bind(fd.get(), ai->ai_addr, ai->ai_addrlen) != 0 || ::listen(fd.get(), SOMAXCONN) != 0) {
       last_error = errno;
       continue;

@@ -143,7 +143,8 @@ Response Api::health() const {
 }
 
 Response Api::session() const {
-  const auto scans = store_.scans();
+  const std::size_t scan_count = store_.scan_count();
+  const std::optional<StoredScan> last = store_.last_scan();
   json robots = json::object();
   for (const auto& [id, r] : store_.robot_states()) {
     robots[id] = {{"state", r.status.state},
@@ -158,7 +159,7 @@ Response Api::session() const {
   }
   json j = {{"session_dir", session_dir_},
             {"started", iso_time(started_)},
-            {"scans", scans.size()},
+            {"scans", scan_count},
             {"points", store_.point_count()},
             {"bridges", dds_.connected_bridges()},
             {"robots", robots}};
@@ -167,13 +168,13 @@ Response Api::session() const {
                 {"low_resolution_m2", areas.low_resolution_m2},
                 {"unscanned_m2", areas.unscanned_m2},
                 {"movable_m2", areas.movable_m2}};
-  if (!scans.empty()) {
+  if (last) {
     const Bounds3 b = store_.bounds();
     j["bounds"] = {{"min", vec3(b.min)}, {"max", vec3(b.max)}};
-    j["last_scan"] = {{"id", scans.back().id},
-                      {"robot", scans.back().robot},
-                      {"points", scans.back().points},
-                      {"pose", pose_json(scans.back().placed)}};
+    j["last_scan"] = {{"id", last->id},
+                      {"robot", last->robot},
+                      {"points", last->points},
+                      {"pose", pose_json(last->placed)}};
   }
   return Response::json(200, j);
 }

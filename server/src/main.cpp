@@ -3,10 +3,15 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <array>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <memory>
+#include <thread>
+#include <vector>
 
 #include "api.hpp"
 #include "auth.hpp"
@@ -25,9 +30,13 @@
 
 namespace {
 
-scanplan::http::HttpServer* g_server = nullptr;
+// The HTTP loops a signal stops; filled before the handlers are installed, then only read.
+constexpr int kMaxHttpThreads = 8;
+std::array<scanplan::http::HttpServer*, kMaxHttpThreads> g_servers{};
 void on_signal(int) {
-  if (g_server) g_server->stop();
+  for (auto* s : g_servers) {
+    if (s) s->stop();
+  }
 }
 
 std::string env_or_empty(const char* name) {
@@ -46,6 +55,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--domain", domain, "DDS domain id")->capture_default_str();
   app.add_option("--web", web_dir, "directory of the built web page")->capture_default_str();
+  // One event loop per core by default: the page, the terminal clients and the other robots'
+  // tools poll the API while scans are processed on other threads.
+  int http_threads = static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 4u));
+  app.add_option("--http-threads", http_threads, "HTTP event loops sharing the port")
+      ->capture_default_str()
+      ->check(CLI::Range(1, kMaxHttpThreads));
   CLI11_PARSE(app, argc, argv);
   spdlog::set_default_logger(spdlog::stderr_color_mt("server"));
 
@@ -96,12 +111,23 @@ int main(int argc, char** argv) {
     router.set_fallback(
         [&files](const http::Request& r, const http::Router::Params&) { return files.serve(r); });
 
-    http::HttpServer server(config, [&router](const http::Request& r) { return router.route(r); });
-    server.start();
+    // Handlers run on several loop threads at once: the API holds no state of its own and the
+    // store, mission, intake and hub guard theirs. The connection limit is shared among them.
+    config.reuse_port = http_threads > 1;
+    config.limits.max_connections =
+        std::max<std::size_t>(1, config.limits.max_connections / http_threads);
+    std::vector<std::unique_ptr<http::HttpServer>> servers;
+    for (int k = 0; k < http_threads; ++k) {
+      servers.push_back(std::make_unique<http::HttpServer>(
+          config, [&router](const http::Request& r) { return router.route(r); }));
+      servers.back()->start();
+      config.port = servers.front()->port();
+    }
+    http::HttpServer& server = *servers.front();
     hub.start();
     intake.start();
     dds.start();
-    g_server = &server;
+    for (std::size_t k = 0; k < servers.size(); ++k) g_servers[k] = servers[k].get();
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
     std::signal(SIGPIPE, SIG_IGN);
@@ -110,8 +136,30 @@ int main(int argc, char** argv) {
     std::cout << "scanplan-server listening on " << url << std::endl;
     if (generated)
       std::cout << "operator link: " << url << "?token=" << operator_token << std::endl;
-    server.run();
-    g_server = nullptr;
+    std::vector<std::thread> loops;
+    for (std::size_t k = 1; k < servers.size(); ++k) {
+      loops.emplace_back([&servers, k] {
+        try {
+          servers[k]->run();
+        } catch (const std::exception& e) {
+          spdlog::error("HTTP loop {}: {}", k, e.what());
+        }
+        // One loop failing takes the others down: a half-served port is worse than a clear exit.
+        for (auto& s : servers) s->stop();
+      });
+    }
+    const auto stop_loops = [&] {
+      for (auto& s : servers) s->stop();
+      for (auto& t : loops) t.join();
+      g_servers.fill(nullptr);
+    };
+    try {
+      server.run();
+    } catch (...) {
+      stop_loops();
+      throw;
+    }
+    stop_loops();
     dds.stop();
     intake.stop();
     hub.stop();

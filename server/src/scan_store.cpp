@@ -26,6 +26,7 @@ void ScanStore::add(const StoredScan& scan, const PointCloud& cloud) {
 
   // Writers take turns on encode_mutex_; readers only wait for the short commit below, and
   // they see the scan, its points and the map encoding that includes it appear together.
+  const Bounds3 added = bounds_of(placed);
   std::lock_guard encode_lock(encode_mutex_);
   PointCloud next;
   {
@@ -44,6 +45,10 @@ void ScanStore::add(const StoredScan& scan, const PointCloud& cloud) {
     offsets_.push_back(map_.size());
     chunks_[scan.id] = chunk;
     map_ = std::move(next);
+    if (added.valid()) {
+      bounds_.extend(added.min);
+      bounds_.extend(added.max);
+    }
     encoded_ = std::move(encoded);
   });
 }
@@ -150,6 +155,12 @@ std::vector<StoredScan> ScanStore::scans() const {
   return scans_;
 }
 
+std::optional<StoredScan> ScanStore::last_scan() const {
+  std::lock_guard lock(mutex_);
+  if (scans_.empty()) return std::nullopt;
+  return scans_.back();
+}
+
 std::size_t ScanStore::scan_count() const {
   std::lock_guard lock(mutex_);
   return scans_.size();
@@ -162,7 +173,7 @@ std::size_t ScanStore::point_count() const {
 
 Bounds3 ScanStore::bounds() const {
   std::lock_guard lock(mutex_);
-  return bounds_of(map_);
+  return bounds_;
 }
 
 ScanStore::EncodedMap ScanStore::encoded_map() const {

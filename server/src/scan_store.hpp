@@ -83,6 +83,7 @@ class ScanStore {
   // The map's points (map frame) within `radius_m` of (x, y) in the x-y plane.
   PointCloud points_near(double x, double y, double radius_m) const;
   std::size_t scan_count() const;
+  std::optional<StoredScan> last_scan() const;
   std::size_t point_count() const;
   Bounds3 bounds() const;
   struct EncodedMap {
@@ -117,6 +118,7 @@ class ScanStore {
   mutable std::mutex mutex_;
   std::vector<StoredScan> scans_;
   PointCloud map_;
+  Bounds3 bounds_;  // of map_, kept as scans arrive: the session endpoint is polled often
   std::shared_ptr<const std::string> encoded_;
   std::vector<std::size_t> offsets_;  // where each scan's points start in map_
   std::map<std::int64_t, std::shared_ptr<const std::string>> chunks_;

@@ -681,5 +681,48 @@ TEST(HttpServer, HandlerExceptionIsLogged) {
   EXPECT_NE(running.log().find("disk on fire"), std::string::npos);
 }
 
+// Several loops on one port (scanplan-server --http-threads): the kernel spreads connections
+// over them and every loop answers; without reuse_port the port stays exclusive.
+TEST(HttpServerReusePort, LoopsShareThePortAndAllServe) {
+  ServerConfig config;
+  config.host = "127.0.0.1";
+  config.port = 0;
+  config.reuse_port = true;
+  config.log = [](std::string_view) {};
+  std::vector<std::unique_ptr<HttpServer>> servers;
+  for (int k = 0; k < 2; ++k) {
+    servers.push_back(std::make_unique<HttpServer>(config, [k](const Request&) {
+      return Response::json(200, {{"loop", k}});
+    }));
+    servers.back()->start();
+    config.port = servers.front()->port();
+  }
+  EXPECT_EQ(servers[1]->port(), servers[0]->port());
+  std::vector<std::thread> threads;
+  for (auto& s : servers) threads.emplace_back([&s] { s->run(); });
+
+  int answered[2] = {0, 0};
+  for (int c = 0; c < 40; ++c) {
+    Client client(config.port);
+    ASSERT_TRUE(client.connected());
+    const auto r = client.request("GET", "/x");
+    ASSERT_EQ(r.status, 200);
+    ++answered[r.json()["loop"].get<int>()];
+  }
+  for (auto& s : servers) s->stop();
+  for (auto& t : threads) t.join();
+  EXPECT_GT(answered[0], 0);
+  EXPECT_GT(answered[1], 0);
+
+  ServerConfig exclusive = config;
+  exclusive.reuse_port = false;
+  exclusive.port = 0;
+  HttpServer first(exclusive, [](const Request&) { return Response::json(200, {}); });
+  first.start();
+  exclusive.port = first.port();
+  HttpServer second(exclusive, [](const Request&) { return Response::json(200, {}); });
+  EXPECT_THROW(second.start(), std::runtime_error);
+}
+
 }  // namespace
 }  // namespace scanplan::http
