@@ -224,6 +224,17 @@ std::vector<StoredScan> SessionStore::scans() const {
   return out;
 }
 
+std::vector<SessionEvent> SessionStore::events(std::size_t limit) const {
+  std::lock_guard lock(mutex_);
+  std::vector<SessionEvent> out;
+  Statement s(db_,
+              "SELECT id, at, kind, json FROM (SELECT id, at, kind, json FROM events "
+              "ORDER BY id DESC LIMIT ?) ORDER BY id");
+  s.bind(1, static_cast<std::int64_t>(limit));
+  while (s.step()) out.push_back({s.integer(0), s.text(1), s.text(2), s.text(3)});
+  return out;
+}
+
 std::optional<StoredScan> SessionStore::scan(std::int64_t id) const {
   std::lock_guard lock(mutex_);
   Statement s(db_, (std::string("SELECT ") + kScanColumns + " FROM scans WHERE id = ?").c_str());

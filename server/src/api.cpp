@@ -25,13 +25,61 @@ json pose_json(const Pose& p) {
   return {{"x", p.x}, {"y", p.y}, {"z", p.z}, {"yaw_deg", rad2deg(p.yaw)}};
 }
 
-json scan_json(const StoredScan& s) {
+json areas_json(const MapAreas& a) {
+  return {{"completed_m2", a.completed_m2},
+          {"low_resolution_m2", a.low_resolution_m2},
+          {"unscanned_m2", a.unscanned_m2},
+          {"movable_m2", a.movable_m2}};
+}
+
+json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas) {
   return {{"id", s.id},
           {"robot", s.robot},
           {"points", s.points},
           {"estimated", pose_json(s.estimated)},
           {"placed", pose_json(s.placed)},
-          {"received_at", s.received_at}};
+          {"received_at", s.received_at},
+          {"areas", areas ? areas_json(*areas) : json(nullptr)}};
+}
+
+json candidate_json(const CandidateRecord& r) {
+  const Candidate& c = r.candidate;
+  json path = json::array();
+  for (const auto& p : c.path) path.push_back({p.x(), p.y()});
+  return {{"id", r.id},
+          {"rank", r.rank},
+          {"state", r.state},
+          {"note", r.note},
+          {"custom", r.custom},
+          {"x", c.position.x()},
+          {"y", c.position.y()},
+          {"z", c.position.z()},
+          {"f", c.f},
+          {"gain_unscanned_m2", c.gain_unscanned_m2},
+          {"gain_low_res_m2", c.gain_low_res_m2},
+          {"travel_m", c.travel_m},
+          {"score", c.score},
+          {"path", path}};
+}
+
+json geometry_json(const LayerGeometry& g) {
+  return {{"min", {g.min_x, g.min_y}},
+          {"max", {g.max_x, g.max_y}},
+          {"px_per_m", g.px_per_m},
+          {"width", g.width},
+          {"height", g.height}};
+}
+
+// A scan id from the query: a whole number >= 0.
+std::int64_t query_scan_id(const Request& r, const std::string& name) {
+  const std::string& v = r.query.at(name);
+  std::int64_t id = 0;
+  const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), id);
+  if (ec != std::errc() || end != v.data() + v.size() || id < 0) {
+    throw HttpError(400, "bad_request",
+                    "'" + name + "' is a scan id (a whole number ≥ 0), got '" + v + "'");
+  }
+  return id;
 }
 
 // A required, finite number from the query string.
@@ -80,7 +128,7 @@ void Api::install(http::Router& router) {
   router.add("GET", "/api/v1/health", [this](const Request&, const auto&) { return health(); });
   router.add("GET", "/api/v1/session", [this](const Request& r, const auto&) {
     require(r, Role::kViewer);
-    return session();
+    return session(r);
   });
   router.add("GET", "/api/v1/map.drc", [this](const Request& r, const auto&) {
     require(r, Role::kViewer);
@@ -113,6 +161,14 @@ void Api::install(http::Router& router) {
                  return decide(r, params.at("id"), action);
                });
   }
+  router.add("POST", "/api/v1/goals", [this](const Request& r, const auto&) {
+    require(r, Role::kOperator);
+    return post_goal(r);
+  });
+  router.add("GET", "/api/v1/decisions", [this](const Request& r, const auto&) {
+    require(r, Role::kViewer);
+    return decisions(r);
+  });
   router.add("GET", "/api/v1/params", [this](const Request& r, const auto&) {
     require(r, Role::kViewer);
     return get_params();
@@ -142,7 +198,7 @@ Response Api::health() const {
   return Response::json(200, {{"status", "ok"}, {"bridges", dds_.connected_bridges()}});
 }
 
-Response Api::session() const {
+Response Api::session(const Request& request) const {
   const std::size_t scan_count = store_.scan_count();
   const std::optional<StoredScan> last = store_.last_scan();
   json robots = json::object();
@@ -162,12 +218,10 @@ Response Api::session() const {
             {"scans", scan_count},
             {"points", store_.point_count()},
             {"bridges", dds_.connected_bridges()},
-            {"robots", robots}};
-  const MapAreas areas = store_.areas();
-  j["areas"] = {{"completed_m2", areas.completed_m2},
-                {"low_resolution_m2", areas.low_resolution_m2},
-                {"unscanned_m2", areas.unscanned_m2},
-                {"movable_m2", areas.movable_m2}};
+            {"robots", robots},
+            {"role", auth_.role_of(request) == Role::kOperator ? "operator" : "viewer"}};
+  j["areas"] = areas_json(store_.areas());
+  if (const auto g = store_.layer_geometry()) j["layers"] = geometry_json(*g);
   if (last) {
     const Bounds3 b = store_.bounds();
     j["bounds"] = {{"min", vec3(b.min)}, {"max", vec3(b.max)}};
@@ -181,15 +235,17 @@ Response Api::session() const {
 
 Response Api::map_drc(const Request& request) const {
   ScanStore::EncodedMap encoded;
-  if (const auto it = request.query.find("since"); it != request.query.end()) {
-    std::int64_t since = 0;
-    const auto [end, ec] =
-        std::from_chars(it->second.data(), it->second.data() + it->second.size(), since);
-    if (ec != std::errc() || end != it->second.data() + it->second.size() || since < 0) {
-      throw HttpError(400, "bad_request",
-                      "'since' is a scan id (a whole number ≥ 0), got '" + it->second + "'");
+  const bool has_since = request.query.count("since") > 0;
+  const bool has_until = request.query.count("until") > 0;
+  if (has_until) {
+    const std::int64_t since = has_since ? query_scan_id(request, "since") : 0;
+    const std::int64_t until = query_scan_id(request, "until");
+    if (until < since) {
+      throw HttpError(400, "bad_request", "'until' must not be less than 'since'");
     }
-    encoded = store_.encoded_since(since);
+    encoded = store_.encoded_range(since, until);
+  } else if (has_since) {
+    encoded = store_.encoded_since(query_scan_id(request, "since"));
   } else {
     encoded = store_.encoded_map();
   }
@@ -211,14 +267,20 @@ Response Api::layer(const std::string& name) const {
     throw HttpError(404, "unknown_layer",
                     "no layer '" + name + "'; the layers are regions, elevation and movable");
   }
-  const auto png = store_.layer_png(name);
-  if (!png) {
+  const LayerImage image = store_.layer(name);
+  if (!image.png) {
     Response empty;
     empty.status = 204;
     return empty;
   }
-  Response r = Response::bytes(std::string(png->begin(), png->end()), "image/png");
+  const auto& png = *image.png;
+  Response r = Response::bytes(std::string(png.begin(), png.end()), "image/png");
   r.set_header("Cache-Control", "no-store");
+  // Where the image lies in the map: its left, bottom, right and top edges in metres.
+  const LayerGeometry& g = image.geometry;
+  r.set_header("X-Scanplan-Layer-Bounds", std::to_string(g.min_x) + "," + std::to_string(g.min_y) +
+                                              "," + std::to_string(g.max_x) + "," +
+                                              std::to_string(g.max_y));
   return r;
 }
 
@@ -248,7 +310,7 @@ Response Api::post_scan(const Request& request) {
                          .count();
   try {
     const StoredScan s = intake_.submit(robot, estimated, stamp, std::move(cloud));
-    return Response::json(201, scan_json(s));
+    return Response::json(201, scan_json(s, std::nullopt));
   } catch (const SessionStoreError& e) {
     throw HttpError(503, "storage_failed",
                     std::string("the scan could not be stored: ") + e.what());
@@ -257,7 +319,7 @@ Response Api::post_scan(const Request& request) {
 
 Response Api::list_scans() const {
   json list = json::array();
-  for (const StoredScan& s : store_.scans()) list.push_back(scan_json(s));
+  for (const StoredScan& s : store_.scans()) list.push_back(scan_json(s, store_.areas_after(s.id)));
   return Response::json(200, {{"scans", list}, {"pending", intake_.pending()}});
 }
 
@@ -268,7 +330,7 @@ Response Api::get_scan(const std::string& id) const {
     throw HttpError(400, "bad_request", "a scan id is a positive whole number, got '" + id + "'");
   }
   for (const StoredScan& s : store_.scans()) {
-    if (s.id == n) return Response::json(200, scan_json(s));
+    if (s.id == n) return Response::json(200, scan_json(s, store_.areas_after(s.id)));
   }
   throw HttpError(404, "not_found", "no scan " + id + " in this session");
 }
@@ -277,24 +339,7 @@ Response Api::candidates() const {
   const auto plan = store_.plan();
   json list = json::array();
   if (!plan) return Response::json(200, {{"plan", nullptr}, {"candidates", list}});
-  for (const CandidateRecord& r : plan->candidates) {
-    const Candidate& c = r.candidate;
-    json path = json::array();
-    for (const auto& p : c.path) path.push_back({p.x(), p.y()});
-    list.push_back({{"id", r.id},
-                    {"rank", r.rank},
-                    {"state", r.state},
-                    {"note", r.note},
-                    {"x", c.position.x()},
-                    {"y", c.position.y()},
-                    {"z", c.position.z()},
-                    {"f", c.f},
-                    {"gain_unscanned_m2", c.gain_unscanned_m2},
-                    {"gain_low_res_m2", c.gain_low_res_m2},
-                    {"travel_m", c.travel_m},
-                    {"score", c.score},
-                    {"path", path}});
-  }
+  for (const CandidateRecord& r : plan->candidates) list.push_back(candidate_json(r));
   return Response::json(200, {{"plan",
                                {{"id", plan->id},
                                 {"based_on_scan", plan->based_on_scan},
@@ -366,6 +411,77 @@ Response Api::decide(const Request& request, const std::string& id, const std::s
     return Response::json(200, out);
   } catch (const MissionError& e) {
     throw HttpError(e.status, e.code, e.what());
+  }
+}
+
+namespace {
+
+// Who decided: the operator may name themselves in the body's "by".
+std::string decided_by(const json& body) {
+  if (body.is_object() && body.contains("by") && body["by"].is_string()) {
+    std::string name = body["by"].get<std::string>();
+    if (name.size() > 100) {
+      throw HttpError(400, "bad_request", "'by' is limited to 100 bytes");
+    }
+    if (!name.empty()) return "operator " + name;
+  }
+  return "operator";
+}
+
+}  // namespace
+
+Response Api::post_goal(const Request& request) {
+  json body;
+  try {
+    body = json::parse(request.body);
+  } catch (const json::parse_error&) {
+    throw HttpError(400, "bad_request",
+                    "the body must be JSON like {\"x\": 12.5, \"y\": -3, \"robot\": \"robot1\"}");
+  }
+  if (!body.is_object()) throw HttpError(400, "bad_request", "the body must be a JSON object");
+  for (const auto& [key, value] : body.items()) {
+    if (key != "x" && key != "y" && key != "robot" && key != "by") {
+      throw HttpError(400, "bad_request", "unknown field '" + key + "'");
+    }
+  }
+  const auto metres = [&body](const char* key) {
+    if (!body.contains(key) || !body[key].is_number() || !std::isfinite(body[key].get<double>())) {
+      throw HttpError(400, "bad_request",
+                      std::string("'") + key + "' is required: a finite number of metres");
+    }
+    return body[key].get<double>();
+  };
+  const double x = metres("x");
+  const double y = metres("y");
+  std::string robot;
+  if (body.contains("robot")) {
+    if (!body["robot"].is_string()) throw HttpError(400, "bad_request", "'robot' is a string");
+    robot = body["robot"].get<std::string>();
+  }
+  try {
+    const CandidateRecord c = mission_.propose(x, y, robot, decided_by(body));
+    return Response::json(201, candidate_json(c));
+  } catch (const MissionError& e) {
+    throw HttpError(e.status, e.code, e.what());
+  }
+}
+
+Response Api::decisions(const Request& request) const {
+  std::size_t limit = 200;
+  if (const auto it = request.query.find("limit"); it != request.query.end()) {
+    std::size_t n = 0;
+    const auto [end, ec] =
+        std::from_chars(it->second.data(), it->second.data() + it->second.size(), n);
+    if (ec != std::errc() || end != it->second.data() + it->second.size() || n < 1 ||
+        n > 1000) {
+      throw HttpError(400, "bad_request", "'limit' is a whole number 1..1000");
+    }
+    limit = n;
+  }
+  try {
+    return Response::json(200, {{"decisions", mission_.log(limit)}});
+  } catch (const SessionStoreError& e) {
+    throw HttpError(503, "storage_failed", std::string("the session cannot be read: ") + e.what());
   }
 }
 

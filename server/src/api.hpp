@@ -24,7 +24,7 @@ class Api {
   void require(const http::Request& request, Role needed) const;
 
   http::Response health() const;
-  http::Response session() const;
+  http::Response session(const http::Request& request) const;
   http::Response map_drc(const http::Request& request) const;
   http::Response layer(const std::string& name) const;
   http::Response request_scan(const http::Request& request);
@@ -34,6 +34,8 @@ class Api {
   http::Response candidates() const;
   http::Response get_params() const;
   http::Response put_params(const http::Request& request);
+  http::Response post_goal(const http::Request& request);
+  http::Response decisions(const http::Request& request) const;
   http::Response decide(const http::Request& request, const std::string& id,
                         const std::string& action);
 

@@ -111,6 +111,45 @@ json Mission::cancel(std::uint64_t id, const std::string& by) {
   return out;
 }
 
+CandidateRecord Mission::propose(double x, double y, const std::string& robot,
+                                 const std::string& by) {
+  // Not under mutex_: add_goal may wait for a scan being brought into the map, and the DDS
+  // thread's on_status must not wait that long.
+  const auto plan = store_.plan();
+  if (!plan) throw MissionError(409, "no_map", "there is no map yet: take a first scan");
+  if (!robot.empty() && robot != plan->robot) {
+    throw MissionError(400, "bad_request",
+                       "the current plan is for robot '" + plan->robot + "', not '" + robot + "'");
+  }
+  CandidateRecord c;
+  try {
+    c = store_.add_goal(x, y);
+  } catch (const GoalRefused& e) {
+    throw MissionError(e.code == "no_map" ? 409 : 400, e.code, e.what());
+  }
+  record("goal", {{"candidate", c.id},
+                  {"robot", plan->robot},
+                  {"x", c.candidate.position.x()},
+                  {"y", c.candidate.position.y()},
+                  {"f", c.candidate.f},
+                  {"travel_m", c.candidate.travel_m},
+                  {"by", by}});
+  return c;
+}
+
+json Mission::log(std::size_t limit) const {
+  json out = json::array();
+  for (const SessionEvent& e : session_.events(limit)) {
+    json entry = json::parse(e.json, nullptr, false);
+    if (!entry.is_object()) entry = json::object();
+    entry["id"] = e.id;
+    entry["at"] = e.at;
+    entry["kind"] = e.kind;
+    out.push_back(std::move(entry));
+  }
+  return out;
+}
+
 void Mission::on_status(const std::string& robot, const RobotStatus& status) {
   std::lock_guard lock(mutex_);
   const auto it = moving_.find(robot);

@@ -1,8 +1,12 @@
 #include "scan_store.hpp"
 
+#include <algorithm>
+#include <cstdio>
+
 #include "scanplan/core/draco_codec.hpp"
 #include "scanplan/core/plan_view.hpp"
 #include "scanplan/core/top_view.hpp"
+#include "scanplan/core/travel_map.hpp"
 
 namespace scanplan::server {
 
@@ -93,6 +97,19 @@ void ScanStore::refresh_derived(const std::function<void()>& commit) {
   layers["movable"] = png(render_movable(pipeline_.map(), movable, regions));
   const MapAreas areas{regions.completed_m2(), regions.low_resolution_m2(), regions.unscanned_m2(),
                        movable.area_m2()};
+  // The layers' pixels in the map, as top_view_pixel places them.
+  LayerGeometry geometry;
+  {
+    const auto& g = regions.cells;
+    const int s = std::max(1, TopViewStyle{}.px_per_cell);
+    geometry.min_x = g.origin.x * g.cell_m;
+    geometry.min_y = g.origin.y * g.cell_m;
+    geometry.max_x = (g.origin.x + g.cols) * g.cell_m;
+    geometry.max_y = (g.origin.y + g.rows) * g.cell_m;
+    geometry.px_per_m = s / g.cell_m;
+    geometry.width = g.cols * s;
+    geometry.height = g.rows * s;
+  }
 
   // The scan, its map and everything derived from it appear to readers together.
   std::lock_guard lock(mutex_);
@@ -104,12 +121,74 @@ void ScanStore::refresh_derived(const std::function<void()>& commit) {
   }
   plan_ = std::move(record);
   layers_ = std::move(layers);
+  layer_geometry_ = geometry;
   areas_ = areas;
+  // A commit means a scan joined (set_params re-segments without one).
+  if (commit) areas_after_[last_scan_.first] = areas;
 }
 
 std::optional<PlanRecord> ScanStore::plan() const {
   std::lock_guard lock(mutex_);
   return plan_;
+}
+
+CandidateRecord ScanStore::add_goal(double x, double y) {
+  std::lock_guard encode_lock(encode_mutex_);
+  {
+    std::lock_guard lock(mutex_);
+    if (!plan_) throw GoalRefused("no_map", "there is no map yet: take a first scan");
+  }
+  if (!pipeline_.regions() || !pipeline_.movable() || !pipeline_.target() ||
+      pipeline_.scan_poses().empty()) {
+    throw GoalRefused("no_map", "there is no map yet: take a first scan");
+  }
+  const MlsMap& map = pipeline_.map();
+  const MovableRegion& movable = *pipeline_.movable();
+  const TargetRegion& target = *pipeline_.target();
+  char where[64];
+  std::snprintf(where, sizeof where, "(%.1f, %.1f)", x, y);
+  if (!target.contains(x, y)) {
+    throw GoalRefused("outside_target",
+                      std::string(where) + " is outside the target region being mapped");
+  }
+  const CellIndex cell = map.index_of(x, y);
+  if (!map.cell(cell)) {
+    throw GoalRefused("no_data", std::string(where) +
+                                     " has not been scanned yet: the robot is only sent where "
+                                     "the map shows it can drive");
+  }
+  if (!movable.contains(cell)) {
+    char why[200];
+    std::snprintf(why, sizeof why,
+                  " is not in the movable region: no floor the robot can reach there (a step "
+                  "over %.2f m, an obstacle or too little headroom)",
+                  planner_.movable.max_step_m);
+    throw GoalRefused("not_movable", where + std::string(why));
+  }
+  const Pose robot = pipeline_.scan_poses().back();
+  const Eigen::Vector3d from(robot.x, robot.y, robot.z);
+  const TravelMap travel = travel_map(map, movable, from, planner_.movable,
+                                      planner_.stay_in_target ? &target : nullptr);
+  if (!travel.reachable(cell)) {
+    throw GoalRefused("unreachable", std::string(where) +
+                                         " is movable but no drive inside the target region "
+                                         "leads there from the robot");
+  }
+  const auto offset = movable.patch.offset(cell);
+  const float floor_z = map.cell(cell)->patches[movable.patch.values[*offset]].mean_z;
+  const Eigen::Vector2d centre = map.center_of(cell);
+  const std::vector<Eigen::Vector2d> points = pipeline_.scan_points();
+  CandidateRecord record;
+  evaluate({map, target, points, from}, planner_, {centre.x(), centre.y(), floor_z},
+           &record.candidate);
+  record.candidate.travel_m = travel.distance(cell);
+  record.candidate.path = travel.path_to(cell);
+  record.id = next_candidate_id_++;
+  record.rank = 0;
+  record.custom = true;
+  std::lock_guard lock(mutex_);
+  plan_->candidates.push_back(record);
+  return record;
 }
 
 bool ScanStore::set_candidate_state(std::uint64_t id, const std::string& state,
@@ -210,6 +289,51 @@ ScanStore::EncodedMap ScanStore::encoded_since(std::int64_t since_id) const {
   }
   if (tail.empty()) return {nullptr, last};
   return {std::make_shared<const std::string>(encode_draco(tail)), last};
+}
+
+ScanStore::EncodedMap ScanStore::encoded_range(std::int64_t since_id,
+                                               std::int64_t until_id) const {
+  PointCloud part;
+  std::int64_t last = 0;
+  {
+    std::lock_guard lock(mutex_);
+    std::size_t first = scans_.size(), end = 0;
+    for (std::size_t i = 0; i < scans_.size(); ++i) {
+      if (scans_[i].id > until_id) break;
+      last = scans_[i].id;
+      if (scans_[i].id > since_id) {
+        first = std::min(first, i);
+        end = i + 1;
+      }
+    }
+    if (first >= end) return {nullptr, last};
+    if (first + 1 == end) return {chunks_.at(scans_[first].id), last};
+    const std::size_t from = offsets_[first];
+    const std::size_t to = end < scans_.size() ? offsets_[end] : map_.size();
+    part.points.assign(map_.points.begin() + from, map_.points.begin() + to);
+    part.colors.assign(map_.colors.begin() + from, map_.colors.begin() + to);
+  }
+  if (part.empty()) return {nullptr, last};
+  return {std::make_shared<const std::string>(encode_draco(part)), last};
+}
+
+std::optional<MapAreas> ScanStore::areas_after(std::int64_t id) const {
+  std::lock_guard lock(mutex_);
+  const auto it = areas_after_.find(id);
+  if (it == areas_after_.end()) return std::nullopt;
+  return it->second;
+}
+
+LayerImage ScanStore::layer(const std::string& name) const {
+  std::lock_guard lock(mutex_);
+  const auto it = layers_.find(name);
+  if (it == layers_.end() || !layer_geometry_) return {};
+  return {it->second, *layer_geometry_};
+}
+
+std::optional<LayerGeometry> ScanStore::layer_geometry() const {
+  std::lock_guard lock(mutex_);
+  return layer_geometry_;
 }
 
 std::shared_ptr<const std::vector<std::uint8_t>> ScanStore::layer_png(

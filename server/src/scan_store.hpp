@@ -5,6 +5,8 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,7 @@ struct CandidateRecord {
   std::string state =
       "proposed";    // proposed, approved, rejected, moving, refused, reached, superseded
   std::string note;  // why, for refused
+  bool custom = false;  // proposed by the operator (POST /api/v1/goals), not by the planner
 };
 
 struct PlanRecord {
@@ -60,6 +63,28 @@ struct PlanRecord {
   double alpha = 0;
   double plan_ms = 0;
   std::vector<CandidateRecord> candidates;
+};
+
+// Where the top-view layers lie in the map: the image spans min.x..max.x left to right and
+// max.y..min.y top to bottom (north up), px_per_m pixels a metre.
+struct LayerGeometry {
+  double min_x = 0, min_y = 0, max_x = 0, max_y = 0;
+  double px_per_m = 0;
+  int width = 0, height = 0;
+};
+
+struct LayerImage {
+  std::shared_ptr<const std::vector<std::uint8_t>> png;  // null before the first scan
+  LayerGeometry geometry;
+};
+
+// A goal the operator asked for that the robot cannot be sent to; `code` names the reason
+// (no_map, outside_target, no_data, not_movable, unreachable).
+class GoalRefused : public std::runtime_error {
+ public:
+  GoalRefused(std::string code, const std::string& message)
+      : std::runtime_error(message), code(std::move(code)) {}
+  std::string code;
 };
 
 // What the operator can change while the mission runs (PUT /api/v1/params).
@@ -94,15 +119,27 @@ class ScanStore {
   // The points of the scans after `since_id` only: what a browser that already holds the map
   // up to that scan needs.
   EncodedMap encoded_since(std::int64_t since_id) const;
+  // The points of the scans with since_id < id <= until_id; last_scan is the newest scan
+  // included, or when there is none the newest scan up to until_id in the map.
+  EncodedMap encoded_range(std::int64_t since_id, std::int64_t until_id) const;
   // Scan `id`'s own points in the map frame, Draco-encoded; null for an unknown id.
   std::shared_ptr<const std::string> encoded_chunk(std::int64_t id) const;
   // A top-view layer as PNG: "regions", "elevation" or "movable"; null before the first scan.
   std::shared_ptr<const std::vector<std::uint8_t>> layer_png(const std::string& name) const;
+  // The same with where it lies in the map (both from the same update).
+  LayerImage layer(const std::string& name) const;
+  std::optional<LayerGeometry> layer_geometry() const;
   static const std::vector<std::string>& layer_names();
   MapAreas areas() const;
+  // The areas right after scan `id` joined the map (nothing for an unknown id).
+  std::optional<MapAreas> areas_after(std::int64_t id) const;
 
   // The latest plan (nothing before the first scan).
   std::optional<PlanRecord> plan() const;
+  // Adds the operator's own goal at (x, y) to the latest plan as a custom candidate (rank 0),
+  // with F (Eq. 1) and the drive there over the movable region from the last scan point.
+  // Throws GoalRefused when there is no plan yet or the robot cannot stand or get there.
+  CandidateRecord add_goal(double x, double y);
   // Sets a candidate's state; false when the id is not in the latest plan.
   bool set_candidate_state(std::uint64_t id, const std::string& state,
                            const std::string& note = "");
@@ -124,6 +161,8 @@ class ScanStore {
   std::map<std::int64_t, std::shared_ptr<const std::string>> chunks_;
   std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> layers_;
   MapAreas areas_;
+  std::map<std::int64_t, MapAreas> areas_after_;  // by scan id
+  std::optional<LayerGeometry> layer_geometry_;
   MappingPipeline pipeline_;                                // written only under encode_mutex_
   PlannerConfig planner_;                                   // written only under encode_mutex_
   std::pair<std::int64_t, std::string> last_scan_;          // id and robot; under encode_mutex_

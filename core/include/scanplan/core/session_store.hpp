@@ -31,6 +31,14 @@ struct StoredScan {
   std::string received_at;  // UTC, ISO 8601
 };
 
+// One row of the session's record of what happened (append_event).
+struct SessionEvent {
+  std::int64_t id = 0;
+  std::string at;  // UTC, ISO 8601 with milliseconds
+  std::string kind;
+  std::string json;
+};
+
 // A session on disk (DESIGN.md "Session directory"): session.sqlite in WAL mode plus one binary
 // PLY per scan under scans/. A scan is acknowledged only once both are durable: the PLY is
 // written to a temporary name, synced and renamed before its row commits, so a process killed
@@ -52,6 +60,8 @@ class SessionStore {
   // Records where matching placed scan `id` in the map.
   void set_placed(std::int64_t id, const Pose& placed);
   std::vector<StoredScan> scans() const;
+  // The newest `limit` events recorded with append_event, oldest first.
+  std::vector<SessionEvent> events(std::size_t limit) const;
   std::optional<StoredScan> scan(std::int64_t id) const;
   PointCloud load_points(const StoredScan& scan) const;
 
