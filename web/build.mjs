@@ -1,5 +1,6 @@
-// Builds the operator page into dist/: index.html, app.js + app.css (esbuild bundle) and
-// draco/ (three's Draco decoder, loaded by DRACOLoader at run time). No network, no CDN.
+// Builds the operator page into dist/: index.html, app.js + app.css (esbuild bundle),
+// map_chunks_worker.js (the map decoder worker) and
+// draco/ (three's Draco decoder, loaded by the worker at run time). No network, no CDN.
 // Usage: node build.mjs [--dev]   (--dev: unminified with source maps)
 import { build } from 'esbuild';
 import { copyFile, mkdir, readFile, rm, writeFile } from 'node:fs/promises';
@@ -14,12 +15,10 @@ const t0 = performance.now();
 await rm(dist, { recursive: true, force: true });
 await mkdir(join(dist, 'draco'), { recursive: true });
 
-const result = await build({
+const common = {
   absWorkingDir: here,
-  entryPoints: { app: 'src/main.js' },
   outdir: dist,
   bundle: true,
-  format: 'esm',
   platform: 'browser',
   target: ['es2022', 'chrome100', 'firefox100', 'safari16'],
   minify: !dev,
@@ -28,7 +27,14 @@ const result = await build({
   charset: 'utf8',
   logLevel: 'warning',
   metafile: true,
-});
+};
+// The page (an ES module) and the map decoder worker (a classic worker: it importScripts the
+// Draco decoder from draco/ beside it, as DRACOLoader's worker does).
+const [page, worker] = await Promise.all([
+  build({ ...common, entryPoints: { app: 'src/main.js' }, format: 'esm' }),
+  build({ ...common, entryPoints: { map_chunks_worker: 'src/map_chunks_worker.js' }, format: 'iife' }),
+]);
+const result = { metafile: { outputs: { ...page.metafile.outputs, ...worker.metafile.outputs } } };
 
 // The decoder files DRACOLoader fetches from setDecoderPath('draco/') (not the gltf/ variant).
 const dracoSrc = join(here, 'node_modules/three/examples/jsm/libs/draco');

@@ -4,7 +4,6 @@
 #include <cstdio>
 
 #include "scanplan/core/draco_codec.hpp"
-#include "scanplan/core/plan_view.hpp"
 #include "scanplan/core/top_view.hpp"
 #include "scanplan/core/travel_map.hpp"
 
@@ -90,9 +89,9 @@ void ScanStore::refresh_derived(const std::function<void()>& commit) {
     return std::make_shared<const std::vector<std::uint8_t>>(encode_png(img));
   };
   std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> layers;
-  cv::Mat regions_img = render_regions(regions, &movable, points);
-  draw_plan(regions_img, regions, plan.ranked, std::nullopt);
-  layers["regions"] = png(regions_img);
+  // The candidates are not drawn in: clients draw them over the layer (the page does, with
+  // their states), and the layer stays the paper's Fig. 4/5.
+  layers["regions"] = png(render_regions(regions, &movable, points));
   layers["elevation"] = png(render_elevation(pipeline_.map(), regions));
   layers["movable"] = png(render_movable(pipeline_.map(), movable, regions));
   const MapAreas areas{regions.completed_m2(), regions.low_resolution_m2(), regions.unscanned_m2(),

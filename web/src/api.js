@@ -62,11 +62,13 @@ export class ApiError extends Error {
     this.code = info.code ?? '';
     this.auth = !!info.auth;
     this.network = !!info.network;
+    this.detail = info.detail ?? ''; // the server's own message, for the operator
+
   }
 }
 
 async function errorFromResponse(res, path) {
-  if (res.status === 401 || res.status === 403) {
+  if (res.status === 401) {
     return new ApiError('token missing or wrong', { status: res.status, code: 'unauthorized', auth: true });
   }
   let code = '';
@@ -85,8 +87,12 @@ async function errorFromResponse(res, path) {
   } catch {
     /* body unreadable */
   }
+  if (res.status === 403) {
+    const detail = message || 'this action needs an operator token';
+    return new ApiError(detail, { status: 403, code: code || 'forbidden', detail });
+  }
   const detail = message || res.statusText || 'request failed';
-  return new ApiError(`${path}: ${res.status} ${detail}${code ? ` (${code})` : ''}`, { status: res.status, code });
+  return new ApiError(`${path}: ${res.status} ${detail}${code ? ` (${code})` : ''}`, { status: res.status, code, detail: message });
 }
 
 /**
@@ -139,6 +145,48 @@ export async function getBinary(path, opts) {
   } catch (e) {
     if (e instanceof ApiError) throw e;
     throw new ApiError(`${path}: download interrupted`, { network: true });
+  } finally {
+    res.done();
+  }
+}
+
+/**
+ * Like getBinary, with the response headers.
+ * @returns {Promise<{body: ArrayBuffer|null, headers: Headers, status: number}>}
+ */
+export async function getBinaryWithHeaders(path, opts) {
+  const res = await apiFetch(path, opts);
+  try {
+    if (res.status === 204) return { body: null, headers: res.headers, status: 204 };
+    const buf = await res.arrayBuffer();
+    return { body: buf.byteLength ? buf : null, headers: res.headers, status: res.status };
+  } catch (e) {
+    if (e instanceof ApiError) throw e;
+    throw new ApiError(`${path}: download interrupted`, { network: true });
+  } finally {
+    res.done();
+  }
+}
+
+/**
+ * Sends JSON with `method` (POST by default) and returns the JSON answer (null for an empty one).
+ * Errors carry the server's message, e.g. why a goal was refused.
+ */
+export async function sendJson(path, body, { method = 'POST', timeoutMs = 15000 } = {}) {
+  const res = await apiFetch(path, {
+    method,
+    timeoutMs,
+    headers: { 'Content-Type': 'application/json' },
+    body: body === undefined ? undefined : JSON.stringify(body),
+  });
+  try {
+    const text = await res.text();
+    if (!text) return null;
+    try {
+      return JSON.parse(text);
+    } catch {
+      throw new ApiError(`${path}: answer is not JSON`, { status: res.status });
+    }
   } finally {
     res.done();
   }

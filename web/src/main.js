@@ -1,143 +1,530 @@
-// scanplan operator page: entry point. Polls the session, downloads and shows the map.
+// scanplan operator page: entry point. Wires the REST snapshot (session, scans, candidates, layers,
+// decisions, annotations) and the live event stream (WebSocket: events and per-scan map chunks)
+// to the panels. On every (re)connection it resynchronises over REST and fetches only the scans it
+// does not hold.
 import './style.css';
-import { ApiError, getBinary, getJson, getToken, initToken } from './api.js';
-import { decodePointCloud, preloadDecoder } from './draco.js';
+import { AnnotationsPanel } from './annotations.js';
+import { apiFetch, getJson, getToken, initToken } from './api.js';
+import { CandidatesPanel } from './candidates.js';
+import { CoverageChart } from './chart.js';
+import { EventStream, OP_MAP_CHUNK, eventsUrl } from './events.js';
+import { GoalPicker } from './goals.js';
+import { DecisionLog } from './log.js';
+import { MapChunks } from './map_chunks.js';
+import { Markers } from './markers.js';
+import { MeasureTool } from './measure.js';
+import { MissionPanel } from './mission.js';
+import { TopView, parseLayerBounds } from './top_view.js';
 import { MapView } from './view.js';
 
-const POLL_MS = 2000;
-const MAP_TIMEOUT_MS = 120000;
-const MAP_RETRY_MS = 10000; // after a failed map download/decode, wait this long before trying again
-
-const $ = (id) => document.getElementById(id);
-const ui = {
-  state: $('conn-state'),
-  scans: $('stat-scans'),
-  points: $('stat-points'),
-  message: $('status-message'),
-  size: $('point-size'),
-  sizeValue: $('point-size-value'),
-  reset: $('reset-view'),
-  view: $('view'),
+const POLL_MS = 10000; // the session, as a link check and for robot poses between events
+const LAYER_LEGENDS = {
+  regions: [['#fad6b4', 'C scan-completed'], ['#ecd040', 'M low-res, movable'], ['#466ec8', 'M low-res, not movable'], ['#404040', 'U unscanned']],
+  elevation: [['linear-gradient(90deg,#30123b,#28bbec,#a2fc3c,#fb8022,#7a0403)', 'low → high']],
+  movable: [['#5abe5a', 'movable'], ['#969696', 'data, not movable'], ['#404040', 'no data']],
 };
 
+const $ = (id) => document.getElementById(id);
 const body = document.body;
 const nf = new Intl.NumberFormat('en-US');
 
 const state = {
-  conn: 'connecting', // connecting | live | error
-  scans: null, // scans in the last session answer
-  points: null, // points in the last session answer
-  mapScans: null, // the `scans` value the rendered map belongs to
-  mapBusy: false,
-  sessionError: null,
-  mapError: null,
-  mapRetryAt: 0,
+  ws: 'connecting',
+  wsInfo: {},
+  role: '',
+  session: null,
+  sessionDir: null,
+  scans: [],
+  error: null, // an error of the session or auth, shown in the top bar
+  pollFailures: 0,
+  layer: 'regions',
+  tool: null, // null | measure | annotate
+  resumedAt: 0,
+  resumeScans: 0,
+  heldAtLoss: 0,
 };
 
+// ---------------------------------------------------------------- views and panels
+let view = null;
+try {
+  view = new MapView($('view'));
+} catch (e) {
+  console.error(e);
+  state.error = new Error('WebGL is not available in this browser: the 3-D map cannot be shown');
+}
+const markers = view ? new Markers(view) : null;
+const measure = view ? new MeasureTool(view, (t) => setViewStatus(t)) : null;
+
+const chunks = new MapChunks({
+  onChunk: (c) => {
+    if (view) view.addChunk(c);
+    render();
+  },
+  onChange: () => render(),
+});
+
+const topView = new TopView($('top-canvas'), {
+  onSelect: (id) => candidates.select(id),
+  onMapClick: (x, y) => goals.set({ x, y }),
+  onHover: (p) => {
+    $('top-coords').textContent = p ? `x ${p.x.toFixed(1)}  y ${p.y.toFixed(1)}` : '';
+  },
+});
+
+const candidates = new CandidatesPanel(
+  { list: $('cand-list'), detail: $('cand-detail'), summary: $('cand-summary') },
+  { onSelect: () => showCandidates(), onChanged: () => refreshCandidates() },
+);
+
+const goals = new GoalPicker(
+  { bar: $('goal-bar'), where: $('goal-where'), propose: $('goal-propose'), clear: $('goal-clear'), msg: $('goal-msg') },
+  {
+    onPending: (p) => topView.setPending(p),
+    onProposed: async (c) => {
+      await refreshCandidates();
+      candidates.select(c.id);
+      selectTab('cands');
+    },
+  },
+);
+
+const mission = new MissionPanel(
+  {
+    robots: $('robots'),
+    progress: $('scan-progress'),
+    bar: $('scan-progress-bar'),
+    progressText: $('scan-progress-text'),
+    match: $('match-result'),
+    scanHere: $('scan-here'),
+    message: $('mission-msg'),
+  },
+  { onChanged: () => refreshSession() },
+);
+
+const chart = new CoverageChart($('chart'), $('chart-readout'));
+const log = new DecisionLog($('log'));
+
+const annotations = new AnnotationsPanel(
+  { list: $('annot-list'), status: $('annot-status'), form: $('annot-form'), count: $('annot-count') },
+  {
+    onChange: (list) => {
+      markers?.setAnnotations(list);
+      topView.setAnnotations(list);
+      updateTools();
+    },
+    onFocus: (a) => view?.focus(a.x, a.y, a.z),
+  },
+);
+
+const events = new EventStream({
+  url: () => eventsUrl(getToken()),
+  onEvent: (e) => onEvent(e),
+  onChunk: (frame) => {
+    if (frame.op === OP_MAP_CHUNK) chunks.addFrame(frame);
+  },
+  onState: (s, info) => onStreamState(s, info),
+});
+
+// ---------------------------------------------------------------- rendering of the page frame
 function setText(el, text) {
   if (el && el.textContent !== text) el.textContent = text;
 }
 
-function render(view) {
-  const err = state.sessionError || state.mapError;
-  const conn = state.sessionError ? 'error' : state.conn;
+function setViewStatus(text) {
+  setText($('view-status'), text);
+}
+
+function render() {
+  const err = state.error;
+  const conn = err ? 'error' : state.ws === 'open' ? 'live' : 'connecting';
   body.dataset.state = conn;
-  body.dataset.scans = String(state.scans ?? 0);
+  body.dataset.ws = state.ws;
+  body.dataset.scans = String(state.session?.scans ?? 0);
   body.dataset.points = String(view ? view.pointCount : 0);
-  setText(ui.state, conn);
-  ui.state.className = `badge ${conn}`;
-  setText(ui.scans, state.scans == null ? '–' : nf.format(state.scans));
-  const shown = view ? view.pointCount : 0;
-  let pts = state.points == null ? '–' : nf.format(state.points);
-  if (view && state.points != null && shown !== state.points) pts += ` (${nf.format(shown)} shown)`;
-  setText(ui.points, pts);
+  body.dataset.drawn = String(view ? view.drawnCount : 0);
+  body.dataset.chunks = String(view ? view.chunkCount : 0);
+  body.dataset.role = state.role;
+  body.dataset.error = err ? err.message : '';
+  setText($('conn-state'), conn);
+  $('conn-state').className = `badge ${conn}`;
+  setText($('role-badge'), state.role ? (state.role === 'operator' ? 'operator' : 'viewer: read only') : '');
+  $('role-badge').className = `role ${state.role}`;
+  setText($('stat-scans'), state.session ? nf.format(state.session.scans) : '–');
+  const held = view ? view.pointCount : 0;
+  let pts = state.session ? nf.format(state.session.points) : '–';
+  if (view && held && view.drawnCount < held) pts += ` (${nf.format(view.drawnCount)} drawn)`;
+  setText($('stat-points'), pts);
+
   let msg = '';
   if (err) msg = err.auth && !getToken() ? `${err.message}: open the page as /?token=YOUR_TOKEN` : err.message;
-  else if (state.mapBusy) msg = 'loading map…';
-  else if (conn === 'connecting') msg = 'connecting to the server…';
-  else if (state.scans === 0) msg = 'waiting for the first scan';
-  setText(ui.message, msg);
-  ui.message.classList.toggle('error', !!err);
-  body.dataset.error = err ? err.message : '';
-}
-
-function toError(e) {
-  if (e instanceof ApiError || e instanceof Error) return e;
-  return new Error(String(e));
-}
-
-let view = null;
-try {
-  view = new MapView(ui.view);
-} catch (e) {
-  console.error(e);
-  state.conn = 'error';
-  state.mapError = new Error('WebGL is not available in this browser: the map cannot be shown');
-}
-
-async function loadMap(scans) {
-  state.mapBusy = true;
-  render(view);
-  try {
-    const buf = await getBinary('/api/v1/map.drc', { timeoutMs: MAP_TIMEOUT_MS });
-    const geometry = buf ? await decodePointCloud(buf) : null;
-    if (view) view.setMap(geometry);
-    else geometry?.dispose();
-    state.mapScans = scans;
-    state.mapError = null;
-  } catch (e) {
-    state.mapError = toError(e);
-    state.mapRetryAt = Date.now() + MAP_RETRY_MS;
-    if (state.mapError.auth) state.sessionError = state.mapError;
-  } finally {
-    state.mapBusy = false;
+  else if (chunks.error) msg = chunks.error.message;
+  else if (chunks.pendingCount || chunks.syncing) {
+    const total = state.scans.length || state.session?.scans || 0;
+    msg = `loading map: ${chunks.held.size} of ${total} scans…`;
+  } else if (!state.session) msg = 'connecting to the server…';
+  else if (state.session && state.session.scans === 0) {
+    msg = state.session.bridges ? 'waiting for the first scan' : 'waiting for the first scan: no robot is connected';
   }
-  render(view);
+  setText($('status-message'), msg);
+  $('status-message').classList.toggle('error', !!err || !!chunks.error);
+  renderBanner();
 }
 
-async function poll() {
+function renderBanner() {
+  const banner = $('banner');
+  const text = $('banner-text');
+  const retry = $('banner-retry');
+  const lost = state.ws === 'lost' || (state.ws === 'connecting' && state.wsInfo.attempt > 0);
+  if (lost) {
+    const secs = Math.max(0, Math.ceil(((state.wsInfo.retryAt || 0) - Date.now()) / 1000));
+    const when = state.ws === 'connecting' ? 'reconnecting now…' : `reconnecting in ${secs} s (attempt ${state.wsInfo.attempt})`;
+    text.textContent = `Connection to the server lost — ${when}. The map on screen is kept; only new scans will be downloaded.`;
+    banner.className = 'lost';
+    banner.hidden = false;
+    retry.hidden = state.ws !== 'lost';
+    body.dataset.banner = 'lost';
+  } else if (state.resumedAt && Date.now() - state.resumedAt < 5000) {
+    const n = state.resumeScans;
+    text.textContent = `Reconnected — ${n ? `fetched ${n} new scan${n > 1 ? 's' : ''}` : 'nothing was missed'}.`;
+    banner.className = 'ok';
+    banner.hidden = false;
+    retry.hidden = true;
+    body.dataset.banner = 'resumed';
+  } else {
+    banner.hidden = true;
+    body.dataset.banner = '';
+  }
+}
+setInterval(renderBanner, 1000);
+$('banner-retry').addEventListener('click', () => events.retryNow());
+
+function applyRole(role) {
+  if (state.role === role) return;
+  state.role = role;
+  const operator = role === 'operator';
+  candidates.setRole(operator);
+  goals.setRole(operator);
+  mission.setRole(operator);
+  annotations.setRole(operator);
+  updateTools();
+}
+
+function updateTools() {
+  const annotate = $('tool-annotate');
+  const operator = state.role === 'operator';
+  annotate.hidden = !operator;
+  annotate.disabled = !annotations.available;
+  annotate.title = annotations.available
+    ? 'mark a victim, hazard, blockage or note at a point of the map'
+    : annotations.reason || 'annotations are not available';
+  if (!annotations.available && state.tool === 'annotate') setTool(null);
+}
+
+// ---------------------------------------------------------------- REST snapshot
+function toError(e) {
+  return e instanceof Error ? e : new Error(String(e));
+}
+
+async function refreshSession() {
   try {
     const s = await getJson('/api/v1/session', { timeoutMs: 10000 });
-    const scans = Number.isFinite(s?.scans) ? s.scans : 0;
-    const points = Number.isFinite(s?.points) ? s.points : null;
-    state.scans = scans;
-    state.points = points;
-    state.conn = 'live';
-    state.sessionError = null;
-    render(view);
-    // Fetch the map when the number of scans changed, or retry after a failed download.
-    const retryDue = !state.mapError || Date.now() >= state.mapRetryAt;
-    if (view && !state.mapBusy && retryDue && (state.mapScans !== scans || state.mapError)) {
-      await loadMap(scans);
+    if (state.sessionDir && s.session_dir !== state.sessionDir) {
+      // Another session on this address: nothing held belongs to it.
+      view?.clear();
+      chunks.reset();
+      chart.clear();
+    }
+    state.sessionDir = s.session_dir;
+    state.session = s;
+    state.error = null;
+    state.pollFailures = 0;
+    applyRole(s.role === 'operator' ? 'operator' : 'viewer');
+    mission.setSession(s);
+    updateRobot();
+    if (s.bounds) {
+      topView.setDataBounds({ minX: s.bounds.min[0], minY: s.bounds.min[1], maxX: s.bounds.max[0], maxY: s.bounds.max[1] });
     }
   } catch (e) {
-    state.sessionError = toError(e);
-    state.conn = 'error';
-    render(view);
+    const err = toError(e);
+    if (err.network) {
+      state.pollFailures += 1;
+      // Two failed polls while the socket looks open: the link is gone, the socket just doesn't know.
+      if (state.pollFailures >= 2 && state.ws === 'open') events.drop('the server stopped answering');
+    } else {
+      state.error = err;
+    }
   }
-  setTimeout(poll, POLL_MS);
+  render();
 }
 
-// Controls
-if (ui.size) {
-  const applySize = () => {
-    const v = Number(ui.size.value);
-    view?.setPointSize(v);
-    setText(ui.sizeValue, `${v}px`);
-  };
-  ui.size.addEventListener('input', applySize);
-  applySize();
+async function refreshScans() {
+  try {
+    const answer = await getJson('/api/v1/scans', { timeoutMs: 15000 });
+    state.scans = answer.scans || [];
+    for (const s of state.scans) if (s.areas) chart.set(s.id, s.areas);
+    markers?.setScans(state.scans);
+    topView.setScans(state.scans);
+    render();
+    if (view) await chunks.sync(state.scans.map((s) => s.id));
+  } catch (e) {
+    if (!toError(e).network) console.warn('scans:', e);
+  }
+  render();
 }
-ui.reset?.addEventListener('click', () => view?.frame());
+
+async function refreshCandidates() {
+  try {
+    const answer = await getJson('/api/v1/candidates', { timeoutMs: 15000 });
+    candidates.setData(answer);
+    showCandidates();
+  } catch (e) {
+    if (!toError(e).network) console.warn('candidates:', e);
+  }
+}
+
+function showCandidates() {
+  const list = candidates.list;
+  markers?.setCandidates(list, candidates.selected);
+  topView.setCandidates(list, candidates.selected);
+  body.dataset.candidates = String(list.length);
+  updateRobot();
+}
+
+let layerBusy = false;
+let layerAgain = false;
+async function refreshLayer() {
+  if (layerBusy) {
+    layerAgain = true;
+    return;
+  }
+  layerBusy = true;
+  try {
+    do {
+      layerAgain = false;
+      const name = state.layer;
+      const res = await apiFetch(`/api/v1/layers/${name}.png`, { timeoutMs: 30000 });
+      try {
+        if (res.status === 204) {
+          topView.setLayer(null, null);
+          continue;
+        }
+        const bounds = parseLayerBounds(res.headers.get('X-Scanplan-Layer-Bounds'));
+        const blob = await res.blob();
+        const image = await createImageBitmap(blob);
+        if (name === state.layer) topView.setLayer(image, bounds);
+        else image.close();
+      } finally {
+        res.done();
+      }
+    } while (layerAgain);
+  } catch (e) {
+    if (!toError(e).network) console.warn('layer:', e);
+  } finally {
+    layerBusy = false;
+  }
+  renderLegend();
+}
+
+function renderLegend() {
+  const legend = $('top-legend');
+  legend.replaceChildren();
+  for (const [color, label] of LAYER_LEGENDS[state.layer] || []) {
+    const item = document.createElement('span');
+    const sw = document.createElement('i');
+    sw.className = color.startsWith('linear') ? 'sw wide' : 'sw';
+    sw.style.background = color;
+    item.append(sw, document.createTextNode(label));
+    legend.append(item);
+  }
+}
+
+async function refreshDecisions() {
+  try {
+    const answer = await getJson('/api/v1/decisions?limit=200', { timeoutMs: 15000 });
+    log.setAll(answer.decisions || []);
+  } catch (e) {
+    if (!toError(e).network) console.warn('decisions:', e);
+  }
+}
+
+/** Everything over REST; after a reconnection only the scans the page lacks are downloaded. */
+async function resync() {
+  await refreshSession();
+  if (state.error?.auth) return;
+  await Promise.all([refreshScans(), refreshCandidates(), refreshLayer(), refreshDecisions(), annotations.load()]);
+}
+
+// ---------------------------------------------------------------- robot, path
+function updateRobot() {
+  const robots = state.session?.robots || {};
+  const ids = Object.keys({ ...robots, ...mission.robots });
+  const id = candidates.plan?.robot && ids.includes(candidates.plan.robot) ? candidates.plan.robot : ids[0];
+  const pose = id ? mission.robotPose(id) : null;
+  markers?.setRobot(pose, id);
+  topView.setRobot(pose);
+  const moving = candidates.moving;
+  if (moving && pose) {
+    markers?.setPath(moving.path, pose.z ?? moving.z, moving.z);
+    mission.setGoalDistance(Math.hypot(moving.x - pose.x, moving.y - pose.y));
+  } else {
+    markers?.setPath(null);
+    mission.setGoalDistance(null);
+  }
+}
+
+// ---------------------------------------------------------------- live events
+let scansTimer = null;
+function soon(fn, ms = 300) {
+  // Several events of one scan arrive together: one REST refresh for all of them.
+  clearTimeout(scansTimer);
+  scansTimer = setTimeout(fn, ms);
+}
+
+function onEvent(e) {
+  switch (e.type) {
+    case 'scan_progress':
+      mission.onScanProgress(e);
+      break;
+    case 'robot_status':
+      mission.onRobotStatus(e);
+      updateRobot();
+      break;
+    case 'scan_received':
+      mission.onScanReceived(e);
+      break;
+    case 'match_done':
+      mission.onMatchDone(e);
+      break;
+    case 'map_updated':
+      mission.onMapUpdated(e);
+      chart.set(e.scan, e);
+      soon(() => {
+        refreshSession();
+        refreshScans();
+        refreshLayer();
+      });
+      break;
+    case 'plan_done':
+      refreshCandidates();
+      refreshLayer();
+      break;
+    case 'mission':
+      log.add(e);
+      refreshCandidates();
+      break;
+    case 'annotation':
+      annotations.onEvent(e);
+      break;
+    case 'binary_dropped':
+      // The server dropped chunks for a slow link: fetch those scans over REST.
+      refreshScans();
+      break;
+    default:
+      break;
+  }
+}
+
+function onStreamState(s, info) {
+  const was = state.ws;
+  state.ws = s;
+  state.wsInfo = info;
+  if (s === 'open') {
+    const resumed = info.resumed;
+    const before = chunks.held.size;
+    resync().then(() => {
+      if (resumed) {
+        state.resumedAt = Date.now();
+        state.resumeScans = Math.max(0, chunks.held.size - before);
+        render();
+      }
+    });
+  } else if (s === 'lost' && was === 'open') {
+    state.heldAtLoss = chunks.held.size;
+  }
+  render();
+}
+
+// ---------------------------------------------------------------- 3-D tools and controls
+function setTool(tool) {
+  state.tool = state.tool === tool ? null : tool;
+  $('tool-measure').setAttribute('aria-pressed', String(state.tool === 'measure'));
+  $('tool-annotate').setAttribute('aria-pressed', String(state.tool === 'annotate'));
+  $('view').classList.toggle('picking', !!state.tool);
+  if (state.tool !== 'annotate') annotations.closeForm();
+  if (state.tool === 'measure') setViewStatus('measure: click the first point on the map');
+  else if (state.tool === 'annotate') setViewStatus('annotate: click the point of the map to mark');
+  else setViewStatus('');
+}
+
+if (view) {
+  view.onClick = (e) => {
+    if (state.tool === 'measure') {
+      measure.handleClick(e);
+    } else if (state.tool === 'annotate') {
+      const hit = view.pick(e.clientX, e.clientY);
+      if (!hit) setViewStatus('annotate: no map point under the cursor; click on the points');
+      else annotations.openForm(hit.point, { x: e.clientX, y: e.clientY });
+    } else {
+      const hit = view.pick(e.clientX, e.clientY);
+      if (hit) {
+        const p = hit.point;
+        setViewStatus(`point (${p.x.toFixed(2)}, ${p.y.toFixed(2)}, ${p.z.toFixed(2)}) of scan ${hit.scan}`);
+      }
+    }
+  };
+  view.onLodChange = () => render();
+}
+
+$('tool-measure').addEventListener('click', () => setTool('measure'));
+$('tool-annotate').addEventListener('click', () => setTool('annotate'));
+$('reset-view').addEventListener('click', () => view?.frame());
+$('color-mode').addEventListener('change', (e) => view?.setColorMode(e.target.value));
+$('budget').addEventListener('change', (e) => view?.setBudget(Number(e.target.value)));
+const applySize = () => {
+  const v = Number($('point-size').value);
+  view?.setPointSize(v);
+  setText($('point-size-value'), `${v}px`);
+};
+$('point-size').addEventListener('input', applySize);
+applySize();
+
+$('layer-select').addEventListener('change', (e) => {
+  state.layer = e.target.value;
+  renderLegend();
+  refreshLayer();
+});
+$('top-fit').addEventListener('click', () => topView.resetView());
+
+function selectTab(name) {
+  for (const b of document.querySelectorAll('.tabs [data-tab]')) b.setAttribute('aria-selected', String(b.dataset.tab === name));
+  $('tab-cands').hidden = name !== 'cands';
+  $('tab-annots').hidden = name !== 'annots';
+}
+for (const b of document.querySelectorAll('.tabs [data-tab]')) b.addEventListener('click', () => selectTab(b.dataset.tab));
+
 window.addEventListener('keydown', (ev) => {
-  if (ev.target instanceof HTMLInputElement) return;
+  if (ev.target instanceof HTMLInputElement || ev.target instanceof HTMLSelectElement || $('confirm').open) return;
   if (ev.key === 'f' || ev.key === 'F') view?.frame();
+  if (ev.key === 'm' || ev.key === 'M') setTool('measure');
+  if (ev.key === 'Escape') {
+    measure?.clear();
+    annotations.closeForm();
+    goals.set(null);
+    if (state.tool) setTool(state.tool);
+  }
 });
 
+// ---------------------------------------------------------------- start
 initToken();
-render(view);
-if (view) preloadDecoder();
-poll();
+render();
+renderLegend();
+if (state.error) {
+  render();
+} else {
+  events.start();
+  resync();
+}
+setInterval(refreshSession, POLL_MS);
 
-// For debugging from the console.
-window.scanplan = { view, state };
+// For the console and for tests.
+window.scanplan = { view, state, chunks, events, topView, candidates, annotations, measure, chart, log, mission };

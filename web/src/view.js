@@ -1,38 +1,93 @@
-// The three.js map view: one Points object for the merged map, orbit controls, z up.
+// The three.js map view: one THREE.Points per scan chunk, orbit controls, z up.
+//
+// Level of detail: the decoder worker shuffles every chunk, so any prefix of its points is an even
+// sample of it. When the points held exceed the budget, each chunk draws the same fraction of its
+// points (a draw range: nothing is re-uploaded); while the camera moves the fraction drops further
+// so orbiting stays fluid, and the full budget comes back when it stops.
+//
+// Colour modes (one shader, chosen by a uniform): the camera's colours, height (turbo ramp over
+// the map's height range) or one colour per scan.
 import {
+  Box3,
+  BufferAttribute,
+  BufferGeometry,
   Color,
+  Group,
   PerspectiveCamera,
   Points,
-  PointsMaterial,
+  Raycaster,
   Scene,
+  ShaderMaterial,
+  Sphere,
+  Vector2,
   Vector3,
   WebGLRenderer,
 } from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { CSS2DRenderer } from 'three/addons/renderers/CSS2DRenderer.js';
 
 export const BACKGROUND = 0x15181d;
+export const COLOR_MODES = { rgb: 0, height: 1, scan: 2 };
+const INTERACTIVE_SHARE = 0.35; // of the budget, while the camera moves
+const NO_COLOUR = [0.72, 0.77, 0.82];
 
-// sRGB (0..1, k/255 steps) -> linear lookup; colours in the map are 8-bit sRGB.
-const SRGB_TO_LINEAR = new Float32Array(256);
-for (let i = 0; i < 256; i++) {
-  const c = i / 255;
-  SRGB_TO_LINEAR[i] = c <= 0.04045 ? c / 12.92 : Math.pow((c + 0.055) / 1.055, 2.4);
-}
+const VERTEX = /* glsl */ `
+  attribute vec3 rgb;
+  uniform float uSize;
+  uniform float uPixelRatio;
+  uniform int uMode;
+  uniform bool uHasRgb;
+  uniform vec2 uZRange;
+  uniform vec3 uScanColor;
+  varying vec3 vColor;
 
-/**
- * Turns decoded Draco colours into three's linear working space in place.
- * Accepts 0..1 floats (uint8 normalized attribute) and, defensively, 0..255 floats
- * (an attribute that was not marked normalized).
- */
-export function colorsToLinear(array) {
-  let max = 0;
-  for (let i = 0; i < array.length; i++) if (array[i] > max) max = array[i];
-  const scale = max > 1.001 ? 1 : 255;
-  for (let i = 0; i < array.length; i++) {
-    let k = Math.round(array[i] * scale);
-    k = k < 0 ? 0 : k > 255 ? 255 : k;
-    array[i] = SRGB_TO_LINEAR[k];
+  // Turbo colour map, polynomial approximation (Mikhailov, Google 2019); sRGB out.
+  vec3 turbo(float x) {
+    const vec4 kr4 = vec4(0.13572138, 4.61539260, -42.66032258, 132.13108234);
+    const vec4 kg4 = vec4(0.09140261, 2.19418839, 4.84296658, -14.18503333);
+    const vec4 kb4 = vec4(0.10667330, 12.64194608, -60.58204836, 110.36276771);
+    const vec2 kr2 = vec2(-152.94239396, 59.28637943);
+    const vec2 kg2 = vec2(4.27729857, 2.82956604);
+    const vec2 kb2 = vec2(-89.90310912, 27.34824973);
+    x = clamp(x, 0.0, 1.0);
+    vec4 v4 = vec4(1.0, x, x * x, x * x * x);
+    vec2 v2 = v4.zw * v4.z;
+    return vec3(dot(v4, kr4) + dot(v2, kr2), dot(v4, kg4) + dot(v2, kg2), dot(v4, kb4) + dot(v2, kb2));
   }
+
+  void main() {
+    gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
+    gl_PointSize = uSize * uPixelRatio;
+    if (uMode == 1) {
+      float span = max(uZRange.y - uZRange.x, 0.01);
+      vColor = turbo((position.z - uZRange.x) / span);
+    } else if (uMode == 2) {
+      vColor = uScanColor;
+    } else {
+      vColor = uHasRgb ? rgb : vec3(${NO_COLOUR.join(', ')});
+    }
+  }
+`;
+
+// Colours are sRGB already (the camera's bytes): written as they are, no colour-space conversion.
+const FRAGMENT = /* glsl */ `
+  varying vec3 vColor;
+  void main() {
+    gl_FragColor = vec4(vColor, 1.0);
+  }
+`;
+
+/** A distinct sRGB colour per scan id (golden-angle hues). */
+export function scanColor(id) {
+  const h = (id * 0.618033988749895) % 1;
+  const s = 0.7;
+  const l = 0.58;
+  const f = (n) => {
+    const k = (n + h * 12) % 12;
+    const a = s * Math.min(l, 1 - l);
+    return l - a * Math.max(-1, Math.min(k - 3, 9 - k, 1));
+  };
+  return [f(0), f(8), f(4)];
 }
 
 export class MapView {
@@ -40,13 +95,21 @@ export class MapView {
   constructor(container) {
     this.container = container;
     this.renderer = new WebGLRenderer({ antialias: false, preserveDrawingBuffer: true, powerPreference: 'high-performance' });
-    this.renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
+    this.pixelRatio = Math.min(window.devicePixelRatio || 1, 2);
+    this.renderer.setPixelRatio(this.pixelRatio);
     this.renderer.setClearColor(BACKGROUND, 1);
     container.appendChild(this.renderer.domElement);
     this.renderer.domElement.id = 'map-canvas';
 
+    this.labels = new CSS2DRenderer();
+    this.labels.domElement.className = 'labels';
+    container.appendChild(this.labels.domElement);
+
     this.scene = new Scene();
     this.scene.background = new Color(BACKGROUND);
+    this.overlay = new Group(); // markers, paths, measurements: drawn over the points
+    this.overlay.name = 'overlay';
+    this.scene.add(this.overlay);
 
     this.camera = new PerspectiveCamera(45, 1, 0.05, 5000);
     this.camera.up.set(0, 0, 1); // our data is z-up; must be set before OrbitControls is made
@@ -58,12 +121,25 @@ export class MapView {
     this.controls.dampingFactor = 0.15;
     this.controls.screenSpacePanning = true;
     this.controls.addEventListener('change', () => this.requestRender());
+    this.controls.addEventListener('start', () => this._setInteracting(true));
+    this.controls.addEventListener('end', () => {
+      clearTimeout(this._idleTimer);
+      this._idleTimer = setTimeout(() => this._setInteracting(false), 250);
+    });
 
-    this.material = new PointsMaterial({ size: 2, sizeAttenuation: false, vertexColors: true });
-    this.points = null;
+    this.chunks = new Map(); // scan id -> {points, material, count}
+    this.bounds = new Box3();
+    this.pointSize = 2;
+    this.colorMode = 'rgb';
+    this.budget = 4_000_000;
+    this.interacting = false;
     this.framed = false;
     this.dirty = true;
+    this.drawn = 0;
+    this.onClick = null; // (event, pick) for tools
+    this.onLodChange = null;
 
+    this._installClick();
     this._resize = () => this.resize();
     window.addEventListener('resize', this._resize);
     if (typeof ResizeObserver === 'function') {
@@ -74,8 +150,20 @@ export class MapView {
     this.renderer.setAnimationLoop(() => this._frame());
   }
 
+  /** Points held (all chunks). */
   get pointCount() {
-    return this.points ? this.points.geometry.getAttribute('position').count : 0;
+    let n = 0;
+    for (const c of this.chunks.values()) n += c.count;
+    return n;
+  }
+
+  /** Points drawn after the level of detail. */
+  get drawnCount() {
+    return this.drawn;
+  }
+
+  get chunkCount() {
+    return this.chunks.size;
   }
 
   requestRender() {
@@ -86,57 +174,141 @@ export class MapView {
     const w = Math.max(1, this.container.clientWidth);
     const h = Math.max(1, this.container.clientHeight);
     this.renderer.setSize(w, h, true);
+    this.labels.setSize(w, h);
     this.camera.aspect = w / h;
     this.camera.updateProjectionMatrix();
     this.requestRender();
   }
 
-  setPointSize(px) {
-    this.material.size = px;
-    this.material.needsUpdate = true;
-    this.requestRender();
+  _material(id, hasRgb) {
+    return new ShaderMaterial({
+      vertexShader: VERTEX,
+      fragmentShader: FRAGMENT,
+      uniforms: {
+        uSize: { value: this.pointSize },
+        uPixelRatio: { value: this.pixelRatio },
+        uMode: { value: COLOR_MODES[this.colorMode] },
+        uHasRgb: { value: hasRgb },
+        uZRange: { value: new Vector2(0, 1) },
+        uScanColor: { value: new Color().fromArray(scanColor(id)) },
+      },
+    });
   }
 
   /**
-   * Replaces the rendered map. `geometry` may be null (no scans yet).
-   * The old geometry is disposed; the shared material is kept (its vertexColors may change).
+   * Adds one scan's points (from the decoder worker). A chunk for an id already shown replaces it.
+   * @param {{id: number, count: number, positions: Float32Array, colors: Uint8Array|null, min: number[], max: number[]}} c
    */
-  setMap(geometry) {
-    if (this.points) {
-      this.scene.remove(this.points);
-      this.points.geometry.dispose();
-      this.points = null;
+  addChunk(c) {
+    if (this.chunks.has(c.id)) this.removeChunk(c.id);
+    if (!c.count) return;
+    const geometry = new BufferGeometry();
+    geometry.setAttribute('position', new BufferAttribute(c.positions, 3));
+    if (c.colors) geometry.setAttribute('rgb', new BufferAttribute(c.colors, 3, true));
+    const box = new Box3(new Vector3(...c.min), new Vector3(...c.max));
+    geometry.boundingBox = box;
+    geometry.boundingSphere = box.getBoundingSphere(new Sphere());
+    const material = this._material(c.id, !!c.colors);
+    const points = new Points(geometry, material);
+    points.name = `scan ${c.id}`;
+    points.userData.scan = c.id;
+    this.scene.add(points);
+    this.chunks.set(c.id, { points, material, count: c.count });
+    this.bounds.union(box);
+    this._updateUniforms();
+    this._applyLod();
+    if (!this.framed) {
+      this.frame();
+      this.framed = true;
+    } else {
+      this._fitClipPlanes();
     }
-    if (geometry && geometry.getAttribute('position') && geometry.getAttribute('position').count > 0) {
-      const hasColor = !!geometry.getAttribute('color');
-      if (this.material.vertexColors !== hasColor) {
-        this.material.vertexColors = hasColor;
-        this.material.color.set(hasColor ? 0xffffff : 0xb8c4d0);
-        this.material.needsUpdate = true;
-      }
-      geometry.computeBoundingBox();
-      geometry.computeBoundingSphere();
-      this.points = new Points(geometry, this.material);
-      this.points.frustumCulled = false;
-      this.scene.add(this.points);
-      if (!this.framed) {
-        this.frame();
-        this.framed = true;
-      } else {
-        this._fitClipPlanes();
-      }
-    } else if (geometry) {
-      geometry.dispose();
+    this.requestRender();
+  }
+
+  removeChunk(id) {
+    const c = this.chunks.get(id);
+    if (!c) return;
+    this.scene.remove(c.points);
+    c.points.geometry.dispose();
+    c.material.dispose();
+    this.chunks.delete(id);
+    this._recomputeBounds();
+    this._applyLod();
+    this.requestRender();
+  }
+
+  clear() {
+    for (const id of [...this.chunks.keys()]) this.removeChunk(id);
+    this.framed = false;
+  }
+
+  _recomputeBounds() {
+    this.bounds.makeEmpty();
+    for (const c of this.chunks.values()) this.bounds.union(c.points.geometry.boundingBox);
+  }
+
+  setPointSize(px) {
+    this.pointSize = px;
+    this._updateUniforms();
+  }
+
+  setColorMode(mode) {
+    if (!(mode in COLOR_MODES)) return;
+    this.colorMode = mode;
+    this._updateUniforms();
+  }
+
+  setBudget(points) {
+    this.budget = Math.max(10_000, points);
+    this._applyLod();
+  }
+
+  _updateUniforms() {
+    const z0 = Number.isFinite(this.bounds.min.z) ? this.bounds.min.z : 0;
+    const z1 = Number.isFinite(this.bounds.max.z) ? this.bounds.max.z : 1;
+    for (const c of this.chunks.values()) {
+      const u = c.material.uniforms;
+      u.uSize.value = this.pointSize;
+      u.uMode.value = COLOR_MODES[this.colorMode];
+      u.uZRange.value.set(z0, z1);
+    }
+    this.requestRender();
+  }
+
+  _setInteracting(on) {
+    if (this.interacting === on) return;
+    this.interacting = on;
+    this._applyLod();
+  }
+
+  /** The share of every chunk that is drawn. */
+  get lodFraction() {
+    const total = this.pointCount;
+    if (!total) return 1;
+    const budget = this.interacting ? this.budget * INTERACTIVE_SHARE : this.budget;
+    return Math.min(1, budget / total);
+  }
+
+  _applyLod() {
+    const f = this.lodFraction;
+    let drawn = 0;
+    for (const c of this.chunks.values()) {
+      const n = f >= 1 ? c.count : Math.max(1, Math.ceil(c.count * f));
+      c.points.geometry.setDrawRange(0, n);
+      drawn += n;
+    }
+    if (drawn !== this.drawn) {
+      this.drawn = drawn;
+      this.onLodChange?.();
     }
     this.requestRender();
   }
 
   /** Puts the whole map in view, looking from the south-west and above. */
   frame() {
-    if (!this.points) return;
-    const geom = this.points.geometry;
-    if (!geom.boundingBox) geom.computeBoundingBox();
-    const box = geom.boundingBox;
+    if (this.bounds.isEmpty()) return;
+    const box = this.bounds;
     const center = box.getCenter(new Vector3());
     const dir = new Vector3(-0.5, -0.7, 0.9).normalize(); // from the target towards the camera
     const right = new Vector3().crossVectors(this.camera.up, dir).normalize();
@@ -165,14 +337,57 @@ export class MapView {
     this.requestRender();
   }
 
+  /** Moves the orbit centre to (x, y, z), keeping the viewing direction and distance. */
+  focus(x, y, z) {
+    const offset = new Vector3().subVectors(this.camera.position, this.controls.target);
+    this.controls.target.set(x, y, z);
+    this.camera.position.copy(this.controls.target).add(offset);
+    this.controls.update();
+    this.requestRender();
+  }
+
   _fitClipPlanes() {
-    const sphere = this.points?.geometry.boundingSphere;
-    if (!sphere) return;
-    const r = Math.max(sphere.radius, 0.5);
+    if (this.bounds.isEmpty()) return;
+    const r = Math.max(this.bounds.getBoundingSphere(new Sphere()).radius, 0.5);
     this.camera.near = Math.max(0.01, r / 2000);
     this.camera.far = Math.max(100, r * 50);
     this.controls.maxDistance = r * 20;
     this.camera.updateProjectionMatrix();
+  }
+
+  /**
+   * The map point under a pixel of the view (client coordinates), or null: the drawn point nearest
+   * the camera within a few pixels of the ray.
+   */
+  pick(clientX, clientY, radiusPx = 6) {
+    if (!this.chunks.size) return null;
+    const rect = this.renderer.domElement.getBoundingClientRect();
+    const ndc = new Vector2(((clientX - rect.left) / rect.width) * 2 - 1, -((clientY - rect.top) / rect.height) * 2 + 1);
+    const ray = new Raycaster();
+    ray.setFromCamera(ndc, this.camera);
+    // World size of a pixel at the orbit centre's distance: the tolerance around the ray.
+    const dist = this.camera.position.distanceTo(this.controls.target);
+    const perPx = (2 * dist * Math.tan(((this.camera.fov * Math.PI) / 180) / 2)) / Math.max(1, rect.height);
+    ray.params.Points = { threshold: Math.max(0.02, radiusPx * perPx) };
+    const hits = ray.intersectObjects([...this.chunks.values()].map((c) => c.points), false);
+    if (!hits.length) return null;
+    const h = hits[0];
+    return { point: h.point.clone(), scan: h.object.userData.scan };
+  }
+
+  _installClick() {
+    const el = this.renderer.domElement;
+    let down = null;
+    el.addEventListener('pointerdown', (e) => {
+      down = { x: e.clientX, y: e.clientY, t: performance.now(), button: e.button };
+    });
+    el.addEventListener('pointerup', (e) => {
+      if (!down || e.button !== 0 || down.button !== 0) return;
+      const moved = Math.hypot(e.clientX - down.x, e.clientY - down.y);
+      const quick = performance.now() - down.t < 600;
+      down = null;
+      if (moved <= 4 && quick && this.onClick) this.onClick(e);
+    });
   }
 
   _frame() {
@@ -180,6 +395,7 @@ export class MapView {
     if (moving || this.dirty) {
       this.dirty = false;
       this.renderer.render(this.scene, this.camera);
+      this.labels.render(this.scene, this.camera);
     }
   }
 
@@ -187,8 +403,7 @@ export class MapView {
     this.renderer.setAnimationLoop(null);
     window.removeEventListener('resize', this._resize);
     this._ro?.disconnect();
-    this.setMap(null);
-    this.material.dispose();
+    this.clear();
     this.controls.dispose();
     this.renderer.dispose();
   }

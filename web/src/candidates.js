@@ -1,0 +1,219 @@
+// The planner's suggestions (GET /api/v1/candidates) as a ranked list, the selected one's details
+// (F, gains, drive), and the operator's decisions on it: approve, reject, cancel a move, each after
+// a confirmation (POST /api/v1/candidates/{id}/approve|reject|cancel). Viewers see no buttons.
+import { sendJson } from './api.js';
+import { confirmAction } from './dialog.js';
+
+const nf0 = new Intl.NumberFormat('en-US', { maximumFractionDigits: 0 });
+const nf1 = new Intl.NumberFormat('en-US', { maximumFractionDigits: 1, minimumFractionDigits: 1 });
+
+const STATE_TEXT = {
+  proposed: 'proposed',
+  moving: 'driving there',
+  reached: 'reached',
+  rejected: 'rejected',
+  refused: 'refused by the robot',
+  cancelled: 'cancelled',
+  superseded: 'superseded',
+};
+
+function el(tag, className, text) {
+  const e = document.createElement(tag);
+  if (className) e.className = className;
+  if (text !== undefined) e.textContent = text;
+  return e;
+}
+
+export function candidateName(c) {
+  return c.custom ? `custom point #${c.id}` : `candidate ${c.rank} (#${c.id})`;
+}
+
+export class CandidatesPanel {
+  /**
+   * @param {{list: HTMLElement, detail: HTMLElement, summary: HTMLElement}} els
+   * @param {{onSelect: (id: number|null) => void, onChanged: () => void}} handlers
+   */
+  constructor(els, { onSelect, onChanged }) {
+    this.els = els;
+    this.onSelect = onSelect;
+    this.onChanged = onChanged;
+    this.plan = null;
+    this.list = [];
+    this.selected = null;
+    this.operator = false;
+    this.busy = false;
+    this.message = '';
+    this.messageIsError = false;
+  }
+
+  setRole(operator) {
+    this.operator = operator;
+    this.render();
+  }
+
+  /** @param {{plan: object|null, candidates: object[]}} answer */
+  setData(answer) {
+    this.plan = answer.plan;
+    this.list = (answer.candidates || []).filter((c) => c.state !== 'superseded');
+    if (this.selected != null && !this.list.some((c) => c.id === this.selected)) {
+      this.selected = null;
+      this.message = ''; // it was about a candidate of an older plan
+    }
+    if (this.selected == null) {
+      // Keep the eye on what matters: a move under way, else the best proposal.
+      const moving = this.list.find((c) => c.state === 'moving');
+      const best = this.list.find((c) => c.state === 'proposed');
+      this.selected = (moving || best)?.id ?? null;
+    }
+    this.render();
+  }
+
+  select(id) {
+    this.selected = id;
+    this.message = '';
+    this.render();
+    this.onSelect(id);
+  }
+
+  get current() {
+    return this.list.find((c) => c.id === this.selected) || null;
+  }
+
+  get moving() {
+    return this.list.find((c) => c.state === 'moving') || null;
+  }
+
+  _say(text, isError = false) {
+    this.message = text;
+    this.messageIsError = isError;
+    this.render();
+  }
+
+  render() {
+    const { list, detail, summary } = this.els;
+    if (this.plan) {
+      const p = this.plan;
+      summary.textContent = `plan ${p.id} after scan ${p.based_on_scan} · ${p.policy}, α ${p.alpha} · ${nf0.format(p.plan_ms)} ms`;
+    } else {
+      summary.textContent = 'no plan yet: the planner runs after each scan';
+    }
+
+    list.replaceChildren();
+    if (!this.list.length) {
+      list.append(el('div', 'empty', this.plan ? 'the planner found no scan point worth making' : 'no candidates yet'));
+    }
+    for (const c of this.list) {
+      const row = el('button', `cand-row state-${c.state}${c.id === this.selected ? ' selected' : ''}`);
+      row.type = 'button';
+      row.dataset.id = String(c.id);
+      row.dataset.state = c.state;
+      row.append(
+        el('span', `rank${c.custom ? ' custom' : ''}`, c.custom ? 'C' : String(c.rank)),
+        el('span', 'f', `F ${nf0.format(c.f)}`),
+        el('span', 'gain', `U ${nf0.format(c.gain_unscanned_m2)} · M ${nf0.format(c.gain_low_res_m2)} m²`),
+        el('span', 'travel', `${nf1.format(c.travel_m)} m`),
+        el('span', 'chip', STATE_TEXT[c.state] ?? c.state),
+      );
+      row.title = `${candidateName(c)} at (${nf1.format(c.x)}, ${nf1.format(c.y)})`;
+      row.addEventListener('click', () => this.select(c.id));
+      list.append(row);
+    }
+
+    detail.replaceChildren();
+    const c = this.current;
+    if (!c) {
+      detail.append(el('div', 'hint', this.list.length ? 'select a candidate in the list or on the top view' : ''));
+    } else {
+      const title = el('div', 'detail-title', `${candidateName(c)} — ${STATE_TEXT[c.state] ?? c.state}`);
+      const grid = el('dl', 'facts');
+      const fact = (k, v) => grid.append(el('dt', '', k), el('dd', '', v));
+      fact('F (Eq. 1)', nf1.format(c.f));
+      fact('gain unscanned', `${nf0.format(c.gain_unscanned_m2)} m²`);
+      fact('gain low-res', `${nf0.format(c.gain_low_res_m2)} m²`);
+      fact('drive', `${nf1.format(c.travel_m)} m`);
+      fact('position', `x ${nf1.format(c.x)}, y ${nf1.format(c.y)}, z ${nf1.format(c.z)}`);
+      if (c.note) fact('note', c.note);
+      for (const dd of grid.querySelectorAll('dd:nth-of-type(n+5)')) dd.classList.add('wide');
+      detail.append(title, grid);
+      if (this.operator) {
+        const actions = el('div', 'actions');
+        if (c.state === 'proposed') {
+          const approve = el('button', 'primary', 'Approve move…');
+          approve.id = 'approve';
+          approve.type = 'button';
+          approve.disabled = this.busy || !!this.moving;
+          if (this.moving) approve.title = 'the robot is still driving to another point';
+          approve.addEventListener('click', () => this.approve(c));
+          const reject = el('button', '', 'Reject…');
+          reject.id = 'reject';
+          reject.type = 'button';
+          reject.disabled = this.busy;
+          reject.addEventListener('click', () => this.reject(c));
+          actions.append(approve, reject);
+        } else if (c.state === 'moving') {
+          const cancel = el('button', 'danger', 'Stop the move…');
+          cancel.id = 'cancel-move';
+          cancel.type = 'button';
+          cancel.disabled = this.busy;
+          cancel.addEventListener('click', () => this.cancel(c));
+          actions.append(cancel);
+        }
+        if (actions.childElementCount) detail.append(actions);
+      }
+    }
+    if (this.message) detail.append(el('div', this.messageIsError ? 'msg error' : 'msg', this.message));
+  }
+
+  async _decide(c, action, body) {
+    this.busy = true;
+    this._say(`${action}: sending…`);
+    try {
+      await sendJson(`/api/v1/candidates/${c.id}/${action}`, body);
+      this.busy = false;
+      const done = { approve: 'approved: the robot is on its way', reject: 'rejected', cancel: 'move stopped' }[action];
+      this._say(done);
+      this.onChanged();
+    } catch (e) {
+      this.busy = false;
+      this._say(`${action} failed: ${e.detail || e.message}`, true);
+      this.onChanged();
+    }
+  }
+
+  async approve(c) {
+    const robot = this.plan?.robot || 'the robot';
+    const ok = await confirmAction({
+      title: `Approve ${candidateName(c)}?`,
+      body: `${robot} will drive ${nf1.format(c.travel_m)} m to (${nf1.format(c.x)}, ${nf1.format(c.y)}) and scan there. Expected gain: F ${nf0.format(c.f)} (${nf0.format(c.gain_unscanned_m2)} m² unscanned, ${nf0.format(c.gain_low_res_m2)} m² low-resolution).`,
+      confirm: 'Approve and drive',
+    });
+    if (!ok) return;
+    await this._decide(c, 'approve', ok.by ? { by: ok.by } : {});
+  }
+
+  async reject(c) {
+    const ok = await confirmAction({
+      title: `Reject ${candidateName(c)}?`,
+      body: 'The robot will not be sent there. The rejection is recorded with your name and reason.',
+      confirm: 'Reject',
+      danger: true,
+      reason: true,
+    });
+    if (!ok) return;
+    const body = {};
+    if (ok.by) body.by = ok.by;
+    if (ok.reason) body.reason = ok.reason;
+    await this._decide(c, 'reject', body);
+  }
+
+  async cancel(c) {
+    const ok = await confirmAction({
+      title: 'Stop the move?',
+      body: `The robot stops where it is now instead of driving to ${candidateName(c)}. No scan is taken.`,
+      confirm: 'Stop the robot',
+      danger: true,
+    });
+    if (!ok) return;
+    await this._decide(c, 'cancel', ok.by ? { by: ok.by } : {});
+  }
+}

@@ -1,0 +1,158 @@
+// The map as per-scan chunks: which scans the page holds, what it still needs, and the decoder
+// worker (map_chunks_worker.js). Chunks come from the WebSocket (one binary frame per new scan)
+// or, for scans the page missed (first load, a lost connection, chunks the server dropped for a
+// slow link), from GET /api/v1/map.drc?since=A&until=B: the points of the scans A < id <= B, so a
+// page never downloads a scan twice.
+import { ApiError, getBinaryWithHeaders } from './api.js';
+
+const MAP_TIMEOUT_MS = 120000;
+
+export class MapChunks {
+  /**
+   * @param {{onChunk: (c: {id: number, count: number, positions: Float32Array,
+   *   colors: Uint8Array|null, min: number[], max: number[]}) => void,
+   *   onChange: () => void}} handlers
+   */
+  constructor({ onChunk, onChange }) {
+    this.onChunk = onChunk;
+    this.onChange = onChange;
+    this.held = new Set(); // scan ids in the view
+    this.pending = new Set(); // being fetched or decoded
+    this.failed = new Map(); // scan id -> message
+    this.syncing = false;
+    this.resyncWanted = null;
+    this.error = null;
+    this.stats = { wsChunks: 0, restChunks: 0, bytes: 0 };
+    this.worker = null;
+    this.jobs = new Map(); // key -> {resolve, reject}
+    this.nextKey = 1;
+  }
+
+  _worker() {
+    if (!this.worker) {
+      this.worker = new Worker(new URL('map_chunks_worker.js', document.baseURI));
+      this.worker.onmessage = (e) => {
+        const m = e.data;
+        const job = this.jobs.get(m.key);
+        if (!job) return;
+        this.jobs.delete(m.key);
+        if (m.type === 'decoded') job.resolve(m);
+        else job.reject(new Error(`map decoding failed: ${m.message}`));
+      };
+      this.worker.onerror = (e) => {
+        // A worker that cannot start fails every job; the next chunk makes a new one.
+        const msg = e.message || 'the decoder worker failed to start';
+        for (const job of this.jobs.values()) job.reject(new Error(`map decoding failed: ${msg}`));
+        this.jobs.clear();
+        this.worker.terminate();
+        this.worker = null;
+      };
+    }
+    return this.worker;
+  }
+
+  _decode(buffer, id) {
+    const key = `${id}:${this.nextKey++}`;
+    return new Promise((resolve, reject) => {
+      this.jobs.set(key, { resolve, reject });
+      try {
+        this._worker().postMessage({ type: 'decode', key, buffer }, [buffer]);
+      } catch (e) {
+        this.jobs.delete(key);
+        reject(e);
+      }
+    });
+  }
+
+  get pendingCount() {
+    return this.pending.size;
+  }
+
+  /** Forgets every chunk (a different session on the server). */
+  reset() {
+    this.held.clear();
+    this.failed.clear();
+    this.error = null;
+    this.onChange();
+  }
+
+  async _take(id, buffer, source) {
+    this.pending.add(id);
+    this.onChange();
+    try {
+      const d = await this._decode(buffer, id);
+      this.pending.delete(id);
+      this.held.add(id);
+      this.failed.delete(id);
+      this.onChunk({ id, count: d.count, positions: d.positions, colors: d.colors, min: d.min, max: d.max, source });
+    } catch (e) {
+      this.pending.delete(id);
+      this.failed.set(id, e.message);
+      this.error = e;
+    }
+    this.onChange();
+  }
+
+  /** A binary frame from the WebSocket (op 1). */
+  addFrame(frame) {
+    const { id, payload } = frame;
+    if (this.held.has(id) || this.pending.has(id) || !payload.byteLength) return;
+    this.stats.wsChunks += 1;
+    this.stats.bytes += payload.byteLength;
+    this._take(id, payload, 'ws');
+  }
+
+  /**
+   * Fetches the chunks of the scans in `ids` (the session's scan ids, ascending) that the page
+   * does not hold, one scan at a time, oldest first. Calls made while one runs are merged.
+   */
+  async sync(ids) {
+    if (this.syncing) {
+      this.resyncWanted = ids;
+      return;
+    }
+    this.syncing = true;
+    this.onChange();
+    try {
+      let list = ids;
+      while (list) {
+        this.resyncWanted = null;
+        await this._fetchMissing(list);
+        list = this.resyncWanted;
+      }
+      this.error = null;
+    } catch (e) {
+      this.error = e instanceof ApiError || e instanceof Error ? e : new Error(String(e));
+    } finally {
+      this.syncing = false;
+      this.onChange();
+    }
+  }
+
+  async _fetchMissing(ids) {
+    const sorted = [...ids].sort((a, b) => a - b);
+    const decodes = [];
+    for (let k = 0; k < sorted.length; k++) {
+      const id = sorted[k];
+      if (this.held.has(id) || this.pending.has(id)) continue;
+      // since = the scan before it (ids may have gaps), so exactly this scan comes back.
+      const since = k > 0 ? sorted[k - 1] : 0;
+      const res = await getBinaryWithHeaders(`/api/v1/map.drc?since=${since}&until=${id}`, { timeoutMs: MAP_TIMEOUT_MS });
+      if (this.held.has(id) || this.pending.has(id)) continue; // the WebSocket was quicker
+      if (!res.body) {
+        this.held.add(id); // no points in it
+        continue;
+      }
+      this.stats.restChunks += 1;
+      this.stats.bytes += res.body.byteLength;
+      decodes.push(this._take(id, res.body, 'rest'));
+    }
+    await Promise.all(decodes);
+  }
+
+  get lastHeld() {
+    let m = 0;
+    for (const id of this.held) if (id > m) m = id;
+    return m;
+  }
+}

@@ -1,0 +1,202 @@
+// What is drawn over the points in the 3-D view: scan positions, the planner's candidates (rank and
+// F), the robot, the approved path and annotations. Drawn without depth test so buildings never hide
+// them; labels are HTML (CSS2DRenderer). Shared geometries and materials are made once and disposed
+// with the markers; groups are rebuilt when their data changes.
+import {
+  BoxGeometry,
+  BufferGeometry,
+  ConeGeometry,
+  CylinderGeometry,
+  Group,
+  Line,
+  LineBasicMaterial,
+  Mesh,
+  MeshBasicMaterial,
+  SphereGeometry,
+  Vector3,
+} from 'three';
+import { CSS2DObject } from 'three/addons/renderers/CSS2DRenderer.js';
+import { scanColor } from './view.js';
+
+export const STATE_COLORS = {
+  proposed: 0xf0b429,
+  moving: 0x3fb950,
+  reached: 0x3fb950,
+  rejected: 0x6e7681,
+  refused: 0xf85149,
+  cancelled: 0x6e7681,
+  superseded: 0x6e7681,
+};
+export const SELECTED_COLOR = 0x39c5f3;
+export const ANNOTATION_COLORS = { victim: 0xff4d6d, hazard: 0xff9f1c, blocked: 0xb388ff, note: 0x4dabf7 };
+const ROBOT_COLOR = 0xff7b29;
+const OVERLAY_ORDER = 10;
+
+function label(text, className) {
+  const el = document.createElement('div');
+  el.className = `marker-label ${className}`;
+  el.textContent = text;
+  return new CSS2DObject(el);
+}
+
+function overlay(obj) {
+  obj.renderOrder = OVERLAY_ORDER;
+  obj.traverse((o) => {
+    o.renderOrder = OVERLAY_ORDER;
+  });
+  return obj;
+}
+
+export class Markers {
+  /** @param {import('./view.js').MapView} view */
+  constructor(view) {
+    this.view = view;
+    this.root = new Group();
+    this.root.name = 'markers';
+    view.overlay.add(this.root);
+    this.groups = {};
+    for (const name of ['scans', 'candidates', 'path', 'robot', 'annotations']) {
+      const g = new Group();
+      g.name = name;
+      this.root.add(g);
+      this.groups[name] = g;
+    }
+    this.geo = {
+      disc: new CylinderGeometry(0.45, 0.45, 0.12, 24).rotateX(Math.PI / 2),
+      pin: new CylinderGeometry(0.06, 0.06, 2.4, 8).rotateX(Math.PI / 2).translate(0, 0, 1.2),
+      head: new SphereGeometry(0.38, 16, 12).translate(0, 0, 2.5),
+      body: new BoxGeometry(0.9, 0.6, 0.45).translate(0, 0, 0.35),
+      nose: new ConeGeometry(0.22, 0.5, 12).rotateZ(-Math.PI / 2).translate(0.65, 0, 0.35),
+      dot: new SphereGeometry(0.3, 12, 10),
+    };
+    this.materials = new Map(); // colour -> material
+    this.lineMaterials = [];
+    this.pathLine = null;
+  }
+
+  _mat(color) {
+    let m = this.materials.get(color);
+    if (!m) {
+      m = new MeshBasicMaterial({ color, depthTest: false, transparent: true, opacity: 0.95 });
+      this.materials.set(color, m);
+    }
+    return m;
+  }
+
+  _clear(name) {
+    const g = this.groups[name];
+    for (const child of [...g.children]) {
+      // A label's element leaves the page only when the label itself is removed from its parent,
+      // not when an ancestor is: remove nested labels one by one.
+      const labels = [];
+      child.traverse((o) => {
+        if (o.isCSS2DObject && o !== child) labels.push(o);
+      });
+      for (const l of labels) l.parent.remove(l);
+      g.remove(child);
+    }
+    if (name === 'path' && this.pathLine) {
+      this.pathLine.geometry.dispose();
+      this.pathLine = null;
+    }
+  }
+
+  /** @param {Array<{id: number, placed: {x: number, y: number, z: number}}>} scans */
+  setScans(scans) {
+    this._clear('scans');
+    for (const s of scans) {
+      const [r, g, b] = scanColor(s.id);
+      const color = (Math.round(r * 255) << 16) | (Math.round(g * 255) << 8) | Math.round(b * 255);
+      const m = overlay(new Mesh(this.geo.disc, this._mat(color)));
+      m.position.set(s.placed.x, s.placed.y, s.placed.z + 0.06);
+      const l = label(`S${s.id}`, 'scan-label');
+      l.position.set(0, 0, 0.4);
+      m.add(l);
+      this.groups.scans.add(m);
+    }
+    this.view.requestRender();
+  }
+
+  /** Candidates of the current plan; `selected` is a candidate id or null. */
+  setCandidates(list, selected) {
+    this._clear('candidates');
+    for (const c of list) {
+      if (c.state === 'superseded') continue;
+      const color = c.id === selected ? SELECTED_COLOR : STATE_COLORS[c.state] ?? STATE_COLORS.proposed;
+      const g = new Group();
+      g.position.set(c.x, c.y, c.z);
+      g.add(overlay(new Mesh(this.geo.pin, this._mat(color))));
+      g.add(overlay(new Mesh(this.geo.head, this._mat(color))));
+      const name = c.custom ? 'custom' : `#${c.rank}`;
+      const l = label(`${name} · F ${Math.round(c.f)}`, `cand-label state-${c.state}${c.id === selected ? ' selected' : ''}`);
+      l.position.set(0, 0, 3.1);
+      g.add(l);
+      g.userData.candidate = c.id;
+      this.groups.candidates.add(g);
+    }
+    this.view.requestRender();
+  }
+
+  /**
+   * The drive of an approved move: 2-D path points lifted between the robot's height and the goal's.
+   * @param {Array<[number, number]>|null} path
+   */
+  setPath(path, z0 = 0, z1 = 0) {
+    this._clear('path');
+    if (!path || path.length < 2) {
+      this.view.requestRender();
+      return;
+    }
+    const pts = path.map(([x, y], i) => new Vector3(x, y, z0 + ((z1 - z0) * i) / (path.length - 1) + 0.2));
+    if (!this.lineMaterials.length) {
+      this.lineMaterials.push(new LineBasicMaterial({ color: STATE_COLORS.moving, depthTest: false, transparent: true }));
+    }
+    this.pathLine = overlay(new Line(new BufferGeometry().setFromPoints(pts), this.lineMaterials[0]));
+    this.groups.path.add(this.pathLine);
+    this.view.requestRender();
+  }
+
+  /** @param {{x: number, y: number, z: number, yaw_deg: number}|null} pose */
+  setRobot(pose, name = 'robot') {
+    this._clear('robot');
+    if (!pose || !Number.isFinite(pose.x)) {
+      this.view.requestRender();
+      return;
+    }
+    const g = new Group();
+    g.add(overlay(new Mesh(this.geo.body, this._mat(ROBOT_COLOR))));
+    g.add(overlay(new Mesh(this.geo.nose, this._mat(ROBOT_COLOR))));
+    const l = label(name, 'robot-label');
+    l.position.set(0, 0, 1.1);
+    g.add(l);
+    g.position.set(pose.x, pose.y, pose.z || 0);
+    g.rotation.z = ((pose.yaw_deg || 0) * Math.PI) / 180;
+    this.groups.robot.add(g);
+    this.view.requestRender();
+  }
+
+  /** @param {Array<{id, kind, x, y, z, text}>} list */
+  setAnnotations(list) {
+    this._clear('annotations');
+    for (const a of list) {
+      const color = ANNOTATION_COLORS[a.kind] ?? ANNOTATION_COLORS.note;
+      const m = overlay(new Mesh(this.geo.dot, this._mat(color)));
+      m.position.set(a.x, a.y, a.z);
+      const text = a.text ? `${a.kind}: ${a.text}` : a.kind;
+      const l = label(text.length > 40 ? `${text.slice(0, 39)}…` : text, `annot-label kind-${a.kind}`);
+      l.position.set(0, 0, 0.6);
+      m.add(l);
+      this.groups.annotations.add(m);
+    }
+    this.view.requestRender();
+  }
+
+  dispose() {
+    for (const name of Object.keys(this.groups)) this._clear(name);
+    this.view.overlay.remove(this.root);
+    for (const g of Object.values(this.geo)) g.dispose();
+    for (const m of this.materials.values()) m.dispose();
+    for (const m of this.lineMaterials) m.dispose();
+    this.materials.clear();
+  }
+}

@@ -1,0 +1,169 @@
+// The mission's live state: each robot's own status (robot_status events and the session's robots),
+// the scan under way as a progress bar (scan_progress: fraction), what became of the last scan
+// (scan_received, match_done: score, RMSE and the correction applied, map_updated), and the
+// operator's "scan here" (POST /api/v1/scan, confirmed first).
+import { sendJson } from './api.js';
+import { confirmAction } from './dialog.js';
+
+const nf0 = new Intl.NumberFormat('en-US', { maximumFractionDigits: 0 });
+const f2 = (v) => (Number.isFinite(v) ? v.toFixed(2) : '–');
+
+const ROBOT_TEXT = {
+  idle: 'idle',
+  moving: 'driving',
+  arrived: 'arrived',
+  refused: 'refused the move',
+  scanning: 'scanning',
+  unknown: 'no status yet',
+};
+
+export class MissionPanel {
+  /** @param {{robots: HTMLElement, progress: HTMLElement, bar: HTMLElement, progressText: HTMLElement, match: HTMLElement, scanHere: HTMLButtonElement, message: HTMLElement}} els */
+  constructor(els, { onChanged }) {
+    this.els = els;
+    this.onChanged = onChanged;
+    this.robots = {}; // id -> {state, message, pose, command_id}
+    this.scan = null; // {robot, state, fraction, message}
+    this.stage = ''; // what happens to the newest scan after it was taken
+    this.match = null;
+    this.goalDistance = null;
+    this.operator = false;
+    this.bridges = 0;
+    els.scanHere.addEventListener('click', () => this.scanHere());
+  }
+
+  setRole(operator) {
+    this.operator = operator;
+    this.render();
+  }
+
+  /** From GET /api/v1/session. */
+  setSession(s) {
+    this.bridges = s.bridges ?? 0;
+    for (const [id, r] of Object.entries(s.robots || {})) {
+      this.robots[id] = { ...(this.robots[id] || {}), state: r.state, message: r.message, pose: r.pose, command_id: r.command_id };
+      if (r.scan && r.scan.state === 'scanning') this.scan = { robot: id, ...r.scan };
+      else if (!this.scan && r.scan && r.scan.state !== 'idle') this.scan = { robot: id, ...r.scan };
+    }
+    this.render();
+  }
+
+  onRobotStatus(e) {
+    this.robots[e.robot] = { ...(this.robots[e.robot] || {}), state: e.state, message: e.message, pose: e.pose, command_id: e.command_id };
+    this.render();
+  }
+
+  onScanProgress(e) {
+    this.scan = { robot: e.robot, state: e.state, fraction: e.fraction, message: e.message, command_id: e.command_id };
+    if (e.state === 'scanning') this.stage = '';
+    if (e.state === 'done') this.stage = 'received by the robot; sending it to the server…';
+    this.render();
+  }
+
+  onScanReceived(e) {
+    this.stage = `scan ${e.scan} stored (${nf0.format(e.points)} points); matching it against the map…`;
+    this.render();
+  }
+
+  onMatchDone(e) {
+    this.match = e;
+    this.stage = `scan ${e.scan} matched; building the map…`;
+    this.render();
+  }
+
+  onMapUpdated(e) {
+    this.stage = `scan ${e.scan} is in the map`;
+    this.render();
+  }
+
+  /** Distance left to the goal of a move under way (or null). */
+  setGoalDistance(d) {
+    this.goalDistance = d;
+    this.render();
+  }
+
+  robotPose(id) {
+    return this.robots[id]?.pose || null;
+  }
+
+  render() {
+    const { robots, bar, progressText, progress, match, scanHere, message } = this.els;
+    robots.replaceChildren();
+    const ids = Object.keys(this.robots);
+    if (!ids.length) {
+      const d = document.createElement('div');
+      d.className = 'muted';
+      d.textContent = this.bridges ? 'robot connected, no status yet' : 'no robot connected';
+      robots.append(d);
+    }
+    for (const id of ids) {
+      const r = this.robots[id];
+      const line = document.createElement('div');
+      line.className = 'robot-line';
+      const name = document.createElement('b');
+      name.textContent = id;
+      const chip = document.createElement('span');
+      chip.className = `chip robot-${r.state}`;
+      chip.textContent = ROBOT_TEXT[r.state] ?? r.state;
+      line.append(name, chip);
+      let extra = r.message || '';
+      if (r.state === 'moving' && this.goalDistance != null) extra = `${this.goalDistance.toFixed(1)} m to go${extra ? ` · ${extra}` : ''}`;
+      if (extra) {
+        const m = document.createElement('span');
+        m.className = 'muted';
+        m.textContent = extra;
+        line.append(m);
+      }
+      robots.append(line);
+    }
+
+    const s = this.scan;
+    const frac = s ? Math.max(0, Math.min(1, Number(s.fraction) || 0)) : 0;
+    bar.style.width = `${(frac * 100).toFixed(1)}%`;
+    progress.dataset.state = s ? s.state : 'idle';
+    progress.dataset.fraction = frac.toFixed(3);
+    progress.classList.toggle('failed', !!s && s.state === 'failed');
+    let text = 'no scan yet';
+    if (s && s.state === 'scanning') text = `scanning ${Math.round(frac * 100)} %`;
+    else if (s && s.state === 'done') text = this.stage || `scan done${s.message ? `: ${s.message}` : ''}`;
+    else if (s && s.state === 'failed') text = `scan failed: ${s.message || 'no reason given'}`;
+    else if (this.stage) text = this.stage;
+    progressText.textContent = text;
+
+    if (this.match) {
+      const m = this.match;
+      const c = m.correction || {};
+      const shift = Math.hypot(c.x || 0, c.y || 0);
+      const verdict = m.applied ? 'correction applied' : `not applied${m.message ? `: ${m.message}` : ''}`;
+      match.textContent = `scan ${m.scan} matched (${m.method}): score ${f2(m.score)}, RMSE ${f2(m.rmse)} m, ` +
+        `shift ${f2(shift)} m / ${f2(c.yaw_deg)}° — ${verdict}`;
+      match.classList.toggle('warn', !m.applied);
+    } else {
+      match.textContent = 'no scan matched in this page yet (the first scan is the reference)';
+      match.classList.remove('warn');
+    }
+    scanHere.hidden = !this.operator;
+    scanHere.disabled = !this.bridges || (s && s.state === 'scanning');
+    message.hidden = !message.textContent;
+  }
+
+  async scanHere() {
+    const ok = await confirmAction({
+      title: 'Scan here?',
+      body: 'Every connected robot takes a scan where it stands now (about a minute).',
+      confirm: 'Scan',
+    });
+    if (!ok) return;
+    const { message } = this.els;
+    try {
+      const r = await sendJson('/api/v1/scan', undefined);
+      message.textContent = `scan requested (command ${r?.command_id ?? '?'})`;
+      message.classList.remove('error');
+    } catch (e) {
+      message.textContent = `scan request failed: ${e.detail || e.message}`;
+      message.classList.add('error');
+    }
+    this.render();
+    this.onChanged();
+  }
+}
