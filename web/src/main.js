@@ -19,7 +19,7 @@ import { MapView } from './view.js';
 
 const POLL_MS = 10000; // the session, as a link check and for robot poses between events
 const LAYER_LEGENDS = {
-  regions: [['#fad6b4', 'C scan-completed'], ['#ecd040', 'M low-res, movable'], ['#466ec8', 'M low-res, not movable'], ['#404040', 'U unscanned']],
+  regions: [['#fad6b4', 'C completed'], ['#ecd040', 'M low-res, movable'], ['#466ec8', 'M not movable'], ['#404040', 'U unscanned']],
   elevation: [['linear-gradient(90deg,#30123b,#28bbec,#a2fc3c,#fb8022,#7a0403)', 'low → high']],
   movable: [['#5abe5a', 'movable'], ['#969696', 'data, not movable'], ['#404040', 'no data']],
 };

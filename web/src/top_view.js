@@ -104,6 +104,7 @@ export class TopView {
   setCandidates(list, selected) {
     this.candidates = list;
     this.selected = selected;
+    if (!this.userMoved) this.fit();
     this.redraw();
   }
 
@@ -124,7 +125,15 @@ export class TopView {
 
   /** Frames the data (or the whole layer) with a margin. */
   fit() {
-    let b = this.dataBounds;
+    let b = this.dataBounds ? { ...this.dataBounds } : null;
+    for (const c of this.candidates) {
+      if (c.state === 'superseded') continue;
+      if (!b) b = { minX: c.x, minY: c.y, maxX: c.x, maxY: c.y };
+      b.minX = Math.min(b.minX, c.x);
+      b.minY = Math.min(b.minY, c.y);
+      b.maxX = Math.max(b.maxX, c.x);
+      b.maxY = Math.max(b.maxY, c.y);
+    }
     if (!b && this.bounds) b = this.bounds;
     if (!b) return;
     const pad = 0.08;

@@ -1,0 +1,137 @@
+// Browser end-to-end test of the operator page (issue 8) against a real server and simulated robot,
+// at the 1366×768 of a field laptop: the map arrives as per-scan chunks, a candidate shows in the
+// list and on the top view, an approval (confirmed) drives the robot and the scan that follows
+// grows the map through a WebSocket chunk (no full map.drc), the coverage chart and the decision
+// log follow; a lost connection shows the banner and resumes with map.drc?since=<last scan held>.
+// Screenshots: $SCREENSHOT_DIR (build/screenshots under ctest).
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { mkdtempSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { requestScan, scanAndWait, startStack, worldVariant } from '../support/stack.mjs';
+import {
+  canvasCoverage,
+  dataset,
+  frames,
+  openPage,
+  overflowing,
+  screenshot,
+  waitForData,
+  withBrowser,
+} from '../support/browser.mjs';
+
+let stack;
+before(async () => {
+  // No pose noise: the robot scans exactly where it was sent, so the test checks positions.
+  const { file } = worldVariant(mkdtempSync(join(tmpdir(), 'scanplan-page-')), 'yard.json', {
+    pose_noise: { xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
+  });
+  stack = await startStack({ world: file, timeScale: 600 });
+  await scanAndWait(stack, 1);
+});
+after(async () => stack && (await stack.stop()));
+
+const session = async () => (await stack.api('GET', '/api/v1/session')).json();
+const fullMapFetches = (requests) => requests.filter((r) => r.path === '/api/v1/map.drc' && !new URLSearchParams(r.search).has('since'));
+
+test('operator page: map, candidates, approval, growth by WebSocket chunk, reconnection', { timeout: 120000 }, async (t) => {
+  await withBrowser(async (context) => {
+    const { page, problems, requests } = await openPage(context, `${stack.url}/?token=${encodeURIComponent(stack.token)}`);
+    const first = await session();
+
+    // 1. The map of scan 1 is drawn, the role is known, the layout fits the screen.
+    await waitForData(page, 'the first scan drawn', (n) => Number(document.body.dataset.points) >= n && document.body.dataset.ws === 'open', first.points);
+    await waitForData(page, 'candidates', () => Number(document.body.dataset.candidates) >= 1);
+    let ds = await dataset(page);
+    assert.equal(ds.state, 'live');
+    assert.equal(ds.role, 'operator');
+    assert.equal(ds.chunks, '1');
+    assert.equal(ds.error, '');
+    await frames(page);
+    const pix = await canvasCoverage(page);
+    t.diagnostic(`3-D canvas ${pix.width}x${pix.height}: ${(pix.fraction * 100).toFixed(2)}% non-background`);
+    assert.ok(pix.fraction > 0.005, `the 3-D view looks blank (${pix.fraction})`);
+    assert.deepEqual(await overflowing(page), [], 'every panel fits in 1366×768');
+
+    // 2. Candidates: in the list and on the top view; a click on the top view selects one.
+    const rows = await page.locator('#cand-list .cand-row').count();
+    assert.ok(rows >= 1, 'candidate rows');
+    if (rows >= 2) await page.locator('#cand-list .cand-row').nth(1).click();
+    const target = await page.evaluate(() => {
+      const tv = window.scanplan.topView;
+      const c = tv.candidates.find((k) => k.rank === 1);
+      const s = tv.screenOf(c.x, c.y);
+      const r = tv.canvas.getBoundingClientRect();
+      return { id: c.id, x: c.x, y: c.y, travel: c.travel_m, f: c.f, px: r.left + s.x, py: r.top + s.y, inside: s.x > 0 && s.y > 0 && s.x < r.width && s.y < r.height };
+    });
+    assert.ok(target.inside, 'the best candidate is inside the top view');
+    await page.mouse.click(target.px, target.py);
+    await frames(page);
+    assert.equal(await page.evaluate(() => window.scanplan.candidates.selected), target.id, 'top-view click selects the candidate');
+    const onTop = await page.evaluate(({ px, py }) => {
+      const tv = window.scanplan.topView;
+      const r = tv.canvas.getBoundingClientRect();
+      const k = tv.dpr;
+      const d = tv.ctx.getImageData(Math.round((px - r.left + 7) * k), Math.round((py - r.top) * k), 1, 1).data;
+      return [d[0], d[1], d[2]];
+    }, target);
+    assert.deepEqual(onTop, [0x39, 0xc5, 0xf3], 'the selected candidate is drawn on the top view');
+    const detail = await page.locator('#cand-detail').innerText();
+    assert.match(detail, /F \(Eq\. 1\)/);
+    assert.match(detail, /gain unscanned/);
+    assert.match(detail, /drive/);
+    t.diagnostic(`shot: ${await screenshot(page, 'operator_page.png')}`);
+
+    // 3. Approve, with a confirmation naming the drive; then the robot moves and scan 2 arrives.
+    await page.click('#approve');
+    await page.waitForSelector('#confirm[open]');
+    assert.match(await page.locator('#confirm-body').innerText(), /will drive .* m to/);
+    await page.fill('#confirm-by', 'Test Operator');
+    t.diagnostic(`shot: ${await screenshot(page, 'approve_confirm.png')}`);
+    await page.click('#confirm-ok');
+    await waitForData(page, 'scan 2 drawn from a WebSocket chunk', () => document.body.dataset.scans === '2' && document.body.dataset.chunks === '2', null, 45000);
+    const second = await session();
+    assert.equal(second.scans, 2);
+    assert.ok(Math.hypot(second.last_scan.pose.x - target.x, second.last_scan.pose.y - target.y) < 0.01, 'scanned where approved');
+    await waitForData(page, 'every point of both scans', (n) => Number(document.body.dataset.points) === n, second.points);
+    const stats = await page.evaluate(() => window.scanplan.chunks.stats);
+    assert.ok(stats.wsChunks >= 1, `scan 2 came over the WebSocket: ${JSON.stringify(stats)}`);
+    assert.deepEqual(fullMapFetches(requests), [], 'the page never downloads the whole map.drc');
+    assert.ok(!requests.some((r) => r.path === '/api/v1/map.drc' && /until=2/.test(r.search)), 'scan 2 was not fetched over REST');
+
+    await waitForData(page, 'two points in the coverage chart', () => document.getElementById('chart').dataset.points === '2');
+    await waitForData(page, 'the approval in the log', () => /approved/.test(document.getElementById('log').textContent));
+    assert.match(await page.locator('#log').innerText(), /Test Operator/);
+    assert.match(await page.locator('#scan-progress-text').innerText(), /scan 2/);
+    await frames(page);
+    t.diagnostic(`shot: ${await screenshot(page, 'operator_after_move.png')}`);
+
+    // 4. The link goes down: the banner shows; a scan made meanwhile comes with since=2 once it is back.
+    await context.setOffline(true);
+    await page.evaluate(() => window.scanplan.events.drop('test: link down'));
+    await waitForData(page, 'the connection-lost banner', () => document.body.dataset.banner === 'lost' && !document.getElementById('banner').hidden);
+    assert.match(await page.locator('#banner').innerText(), /Connection to the server lost/);
+    await frames(page);
+    t.diagnostic(`shot: ${await screenshot(page, 'connection_lost.png')}`);
+    const before = requests.length;
+    await requestScan(stack);
+    const third = await stack.waitFor('scan 3 in the session', async () => {
+      const s = await session();
+      return s.scans >= 3 ? s : undefined;
+    });
+    ds = await dataset(page);
+    assert.equal(ds.chunks, '2', 'nothing arrives while the link is down');
+    await context.setOffline(false);
+    await page.evaluate(() => window.scanplan.events.retryNow());
+    await waitForData(page, 'the map resumed with scan 3', (n) => document.body.dataset.ws === 'open' && document.body.dataset.chunks === '3' && Number(document.body.dataset.points) === n, third.points, 30000);
+    await waitForData(page, 'the banner to say it reconnected', () => document.body.dataset.banner !== 'lost');
+    const resumed = requests.slice(before).filter((r) => r.path === '/api/v1/map.drc');
+    assert.deepEqual(resumed.map((r) => r.search), ['?since=2&until=3'], 'only the missed scan is downloaded');
+    assert.deepEqual(fullMapFetches(requests), []);
+    assert.equal(await page.evaluate(() => window.scanplan.view.chunkCount), 3);
+
+    assert.deepEqual(problems.pageErrors, [], 'uncaught page errors');
+    assert.deepEqual(problems.consoleErrors.filter((m) => !/ERR_INTERNET_DISCONNECTED|Failed to load resource|WebSocket/.test(m)), [], 'console errors');
+  });
+});
