@@ -1,6 +1,6 @@
 // Browser end-to-end test of the operator page (issue 8) against a real server and simulated robot,
 // at the 1366×768 of a field laptop: the map arrives as per-scan chunks, a candidate shows in the
-// list and on the top view, an approval (confirmed) drives the robot and the scan that follows
+// list and on the top view, a custom point is proposed from the top view, an approval (confirmed) drives the robot and the scan that follows
 // grows the map through a WebSocket chunk (no full map.drc), the coverage chart and the decision
 // log follow; a lost connection shows the banner and resumes with map.drc?since=<last scan held>.
 // Screenshots: $SCREENSHOT_DIR (build/screenshots under ctest).
@@ -83,7 +83,32 @@ test('operator page: map, candidates, approval, growth by WebSocket chunk, recon
     assert.match(detail, /drive/);
     t.diagnostic(`shot: ${await screenshot(page, 'operator_page.png')}`);
 
-    // 3. Approve, with a confirmation naming the drive; then the robot moves and scan 2 arrives.
+    // 3. A click on the top view proposes the operator's own point: refused where the robot cannot
+    // stand (the server's reason is shown), added as a custom candidate where it can.
+    const clickMap = async (x, y) => {
+      const p = await page.evaluate(([mx, my]) => {
+        const tv = window.scanplan.topView;
+        const s = tv.screenOf(mx, my);
+        const r = tv.canvas.getBoundingClientRect();
+        return { x: r.left + s.x, y: r.top + s.y };
+      }, [x, y]);
+      await page.mouse.click(p.x, p.y);
+    };
+    await clickMap(-17.4, 8.6); // on a 1 m crate
+    await page.click('#goal-propose');
+    await waitForData(page, 'the refusal', () => /not possible/.test(document.getElementById('goal-msg').textContent));
+    assert.match(await page.locator('#goal-msg').innerText(), /not in the movable region/);
+    await clickMap(-9.3, -6.2); // open ground near the robot
+    assert.match(await page.locator('#goal-where').innerText(), /\(-9\.\d, -6\.\d\)/);
+    await page.click('#goal-propose');
+    await waitForData(page, 'the custom candidate', () => !!document.querySelector('#cand-list .cand-row .rank.custom'));
+    assert.match(await page.locator('#cand-detail').innerText(), /custom point/);
+    assert.ok(await page.locator('#goal-bar').isHidden(), 'the proposed point is taken over by the candidate');
+    t.diagnostic(`shot: ${await screenshot(page, 'custom_goal.png')}`);
+    await page.locator(`#cand-list .cand-row[data-id="${target.id}"]`).click(); // back to the planner's best
+    assert.equal(await page.evaluate(() => window.scanplan.candidates.selected), target.id);
+
+    // 4. Approve, with a confirmation naming the drive; then the robot moves and scan 2 arrives.
     await page.click('#approve');
     await page.waitForSelector('#confirm[open]');
     assert.match(await page.locator('#confirm-body').innerText(), /will drive .* m to/);
@@ -107,7 +132,7 @@ test('operator page: map, candidates, approval, growth by WebSocket chunk, recon
     await frames(page);
     t.diagnostic(`shot: ${await screenshot(page, 'operator_after_move.png')}`);
 
-    // 4. The link goes down: the banner shows; a scan made meanwhile comes with since=2 once it is back.
+    // 5. The link goes down: the banner shows; a scan made meanwhile comes with since=2 once it is back.
     await context.setOffline(true);
     await page.evaluate(() => window.scanplan.events.drop('test: link down'));
     await waitForData(page, 'the connection-lost banner', () => document.body.dataset.banner === 'lost' && !document.getElementById('banner').hidden);

@@ -5,7 +5,8 @@ import { sendJson } from './api.js';
 import { confirmAction } from './dialog.js';
 
 const nf0 = new Intl.NumberFormat('en-US', { maximumFractionDigits: 0 });
-const nf1 = new Intl.NumberFormat('en-US', { maximumFractionDigits: 1, minimumFractionDigits: 1 });
+// signDisplay 'negative': no "-0.0" for a height just below zero.
+const nf1 = new Intl.NumberFormat('en-US', { maximumFractionDigits: 1, minimumFractionDigits: 1, signDisplay: 'negative' });
 
 const STATE_TEXT = {
   proposed: 'proposed',

@@ -348,6 +348,8 @@ export class TopView {
     const px = len * this.scale;
     const x0 = 8;
     const y0 = h - 10;
+    ctx.fillStyle = 'rgba(13, 17, 23, 0.75)';
+    ctx.fillRect(x0 - 4, y0 - 14, px + 44, 18);
     ctx.strokeStyle = '#e6edf3';
     ctx.lineWidth = 2;
     ctx.beginPath();
