@@ -210,7 +210,8 @@ StoredScan SessionStore::add_scan(const std::string& robot, const Pose& estimate
 
 void SessionStore::set_placed(std::int64_t id, const Pose& p) {
   std::lock_guard lock(mutex_);
-  Statement s(db_, "UPDATE scans SET x = ?, y = ?, z = ?, roll = ?, pitch = ?, yaw = ? WHERE id = ?");
+  Statement s(db_,
+              "UPDATE scans SET x = ?, y = ?, z = ?, roll = ?, pitch = ?, yaw = ? WHERE id = ?");
   s.bind(1, p.x).bind(2, p.y).bind(3, p.z).bind(4, p.roll).bind(5, p.pitch).bind(6, p.yaw);
   s.bind(7, id);
   s.step();

@@ -472,8 +472,7 @@ Response Api::decisions(const Request& request) const {
     std::size_t n = 0;
     const auto [end, ec] =
         std::from_chars(it->second.data(), it->second.data() + it->second.size(), n);
-    if (ec != std::errc() || end != it->second.data() + it->second.size() || n < 1 ||
-        n > 1000) {
+    if (ec != std::errc() || end != it->second.data() + it->second.size() || n < 1 || n > 1000) {
       throw HttpError(400, "bad_request", "'limit' is a whole number 1..1000");
     }
     limit = n;

@@ -166,8 +166,8 @@ CandidateRecord ScanStore::add_goal(double x, double y) {
   }
   const Pose robot = pipeline_.scan_poses().back();
   const Eigen::Vector3d from(robot.x, robot.y, robot.z);
-  const TravelMap travel = travel_map(map, movable, from, planner_.movable,
-                                      planner_.stay_in_target ? &target : nullptr);
+  const TravelMap travel =
+      travel_map(map, movable, from, planner_.movable, planner_.stay_in_target ? &target : nullptr);
   if (!travel.reachable(cell)) {
     throw GoalRefused("unreachable", std::string(where) +
                                          " is movable but no drive inside the target region "
@@ -290,8 +290,7 @@ ScanStore::EncodedMap ScanStore::encoded_since(std::int64_t since_id) const {
   return {std::make_shared<const std::string>(encode_draco(tail)), last};
 }
 
-ScanStore::EncodedMap ScanStore::encoded_range(std::int64_t since_id,
-                                               std::int64_t until_id) const {
+ScanStore::EncodedMap ScanStore::encoded_range(std::int64_t since_id, std::int64_t until_id) const {
   PointCloud part;
   std::int64_t last = 0;
   {

@@ -50,8 +50,8 @@ struct CandidateRecord {
   int rank = 0;          // 1 = best
   Candidate candidate;
   std::string state =
-      "proposed";    // proposed, approved, rejected, moving, refused, reached, superseded
-  std::string note;  // why, for refused
+      "proposed";       // proposed, approved, rejected, moving, refused, reached, superseded
+  std::string note;     // why, for refused
   bool custom = false;  // proposed by the operator (POST /api/v1/goals), not by the planner
 };
 

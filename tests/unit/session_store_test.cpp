@@ -54,6 +54,28 @@ TEST_F(SessionDir, ScansSurviveReopeningWithPosesAndPoints) {
   EXPECT_EQ(s.add_scan("robot1", est, placed, 44, cloud_of(1, 0)).id, 3);
 }
 
+TEST_F(SessionDir, EventsReadBackNewestLimitOldestFirst) {
+  {
+    SessionStore s(dir_);
+    EXPECT_TRUE(s.events(10).empty());
+    for (int k = 1; k <= 5; ++k) {
+      s.append_event(k % 2 ? "approve" : "reject", "{\"candidate\":" + std::to_string(k) + "}");
+    }
+  }
+  SessionStore s(dir_);  // what was recorded survives reopening
+  const auto all = s.events(100);
+  ASSERT_EQ(all.size(), 5u);
+  EXPECT_EQ(all.front().kind, "approve");
+  EXPECT_EQ(all.front().json, R"({"candidate":1})");
+  EXPECT_EQ(all.back().json, R"({"candidate":5})");
+  for (std::size_t k = 1; k < all.size(); ++k) EXPECT_LT(all[k - 1].id, all[k].id);
+  EXPECT_EQ(all.front().at.size(), std::string("2026-01-01T00:00:00.000Z").size());
+  const auto last = s.events(2);
+  ASSERT_EQ(last.size(), 2u);
+  EXPECT_EQ(last[0].json, R"({"candidate":4})");
+  EXPECT_EQ(last[1].kind, "approve");
+}
+
 TEST_F(SessionDir, PartialWritesFromACrashAreDiscardedOnOpen) {
   {
     SessionStore first(dir_);
