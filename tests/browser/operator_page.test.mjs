@@ -109,6 +109,18 @@ test('operator page: map, candidates, approval, growth by WebSocket chunk, recon
     assert.equal(await page.evaluate(() => window.scanplan.candidates.selected), target.id);
 
     // 4. Approve, with a confirmation naming the drive; then the robot moves and scan 2 arrives.
+    // What the mission panel is told on the way is recorded.
+    await page.evaluate(() => {
+      const m = window.scanplan.mission;
+      window.seen = { robot: [], progress: [] };
+      for (const [name, key, field] of [['onRobotStatus', 'robot', 'state'], ['onScanProgress', 'progress', 'fraction']]) {
+        const original = m[name].bind(m);
+        m[name] = (e) => {
+          window.seen[key].push(e[field]);
+          original(e);
+        };
+      }
+    });
     await page.click('#approve');
     await page.waitForSelector('#confirm[open]');
     assert.match(await page.locator('#confirm-body').innerText(), /will drive .* m to/);
@@ -129,6 +141,14 @@ test('operator page: map, candidates, approval, growth by WebSocket chunk, recon
     await waitForData(page, 'the approval in the log', () => /approved/.test(document.getElementById('log').textContent));
     assert.match(await page.locator('#log').innerText(), /Test Operator/);
     assert.match(await page.locator('#scan-progress-text').innerText(), /scan 2/);
+    const seen = await page.evaluate(() => window.seen);
+    t.diagnostic(`robot states ${seen.robot.join(' ')}; scan fractions ${seen.progress.map((f) => f.toFixed(2)).join(' ')}`);
+    assert.ok(seen.robot.includes('moving') && seen.robot.includes('arrived'), `the move's states: ${seen.robot}`);
+    assert.ok(seen.progress.some((f) => f > 0 && f < 1) && seen.progress.includes(1), `scan progress: ${seen.progress}`);
+    assert.equal(await page.locator('#scan-progress').getAttribute('data-fraction'), '1.000');
+    await waitForData(page, 'the match result of scan 2', () => /scan 2 matched/.test(document.getElementById('match-result').textContent));
+    assert.match(await page.locator('#match-result').innerText(), /score [\d.]+, RMSE [\d.]+ m, shift [\d.]+ m/);
+    assert.match(await page.locator('#log').innerText(), /robot1 arrived at #/);
     await frames(page);
     t.diagnostic(`shot: ${await screenshot(page, 'operator_after_move.png')}`);
 
@@ -156,6 +176,7 @@ test('operator page: map, candidates, approval, growth by WebSocket chunk, recon
     assert.deepEqual(fullMapFetches(requests), []);
     assert.equal(await page.evaluate(() => window.scanplan.view.chunkCount), 3);
 
+    assert.deepEqual(problems.foreignRequests, [], 'every asset comes from our server');
     assert.deepEqual(problems.pageErrors, [], 'uncaught page errors');
     assert.deepEqual(problems.consoleErrors.filter((m) => !/ERR_INTERNET_DISCONNECTED|Failed to load resource|WebSocket/.test(m)), [], 'console errors');
   });

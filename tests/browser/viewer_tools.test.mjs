@@ -61,6 +61,7 @@ test('a viewer sees the map and the plan but no action buttons', { timeout: 6000
     assert.ok(await page.locator('#goal-bar').isVisible(), 'the clicked position is shown');
     assert.ok(await page.locator('#goal-propose').isHidden(), 'viewers cannot propose goals');
     t.diagnostic(`shot: ${await screenshot(page, 'viewer.png')}`);
+    assert.deepEqual(problems.foreignRequests, [], 'every asset comes from our server');
     assert.deepEqual(problems.pageErrors, []);
     assert.deepEqual(problems.consoleErrors, []);
   });

@@ -46,18 +46,22 @@ export async function withBrowser(fn) {
 
 /**
  * A page with its problems collected: uncaught errors, console errors (except the 404 of a
- * probed endpoint, which the page handles), and every API request made.
+ * probed endpoint, which the page handles), requests to anywhere but our server, and every API
+ * request made.
  */
 export async function openPage(context, url) {
   const page = await context.newPage();
-  const problems = { pageErrors: [], consoleErrors: [] };
+  const problems = { pageErrors: [], consoleErrors: [], foreignRequests: [] };
   const requests = [];
+  const origin = new URL(url).origin;
   page.on('pageerror', (e) => problems.pageErrors.push(String(e && e.stack ? e.stack : e)));
   page.on('console', (m) => {
     if (m.type() === 'error' && !/status of 404/.test(m.text())) problems.consoleErrors.push(m.text());
   });
   page.on('request', (r) => {
     const u = new URL(r.url());
+    // Everything must come from our server: the page works with no internet.
+    if (!['data:', 'blob:'].includes(u.protocol) && u.origin !== origin) problems.foreignRequests.push(r.url());
     if (u.pathname.startsWith('/api/')) requests.push({ method: r.method(), path: u.pathname, search: u.search });
   });
   const res = await page.goto(url, { waitUntil: 'load', timeout: 30000 });

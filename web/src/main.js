@@ -424,11 +424,13 @@ function onEvent(e) {
   }
 }
 
+let firstSnapshot = null; // the REST snapshot taken without waiting for the socket any longer
 function onStreamState(s, info) {
   const was = state.ws;
   state.ws = s;
   state.wsInfo = info;
   if (s === 'open') {
+    clearTimeout(firstSnapshot);
     const resumed = info.resumed;
     const before = chunks.held.size;
     resync().then(() => {
@@ -521,8 +523,10 @@ renderLegend();
 if (state.error) {
   render();
 } else {
+  // The snapshot follows the socket's opening, so no event falls between the two; a socket that
+  // cannot open (a proxy, a dead link) must not keep the map away, though.
   events.start();
-  resync();
+  firstSnapshot = setTimeout(resync, 3000);
 }
 setInterval(refreshSession, POLL_MS);
 
