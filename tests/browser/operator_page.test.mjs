@@ -105,6 +105,14 @@ test('operator page: map, candidates, approval, growth by WebSocket chunk, recon
     assert.match(await page.locator('#cand-detail').innerText(), /custom point/);
     assert.ok(await page.locator('#goal-bar').isHidden(), 'the proposed point is taken over by the candidate');
     t.diagnostic(`shot: ${await screenshot(page, 'custom_goal.png')}`);
+    // Reject the custom point, with a reason, after the confirmation.
+    await page.click('#reject');
+    await page.waitForSelector('#confirm[open]');
+    assert.ok(await page.locator('#confirm-reason').isVisible(), 'a rejection asks for the reason');
+    await page.fill('#confirm-reason', 'rubble on the way');
+    await page.click('#confirm-ok');
+    await waitForData(page, 'the custom point rejected', () => document.querySelector('#cand-list .cand-row .rank.custom')?.closest('.cand-row')?.dataset.state === 'rejected');
+    await waitForData(page, 'the rejection in the log', () => /rejected #\d+: rubble on the way/.test(document.getElementById('log').textContent));
     await page.locator(`#cand-list .cand-row[data-id="${target.id}"]`).click(); // back to the planner's best
     assert.equal(await page.evaluate(() => window.scanplan.candidates.selected), target.id);
 

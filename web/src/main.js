@@ -264,6 +264,7 @@ async function refreshScans() {
     for (const s of state.scans) if (s.areas) chart.set(s.id, s.areas);
     markers?.setScans(state.scans);
     topView.setScans(state.scans);
+    mission.setScans(state.scans);
     render();
     if (view) await chunks.sync(state.scans.map((s) => s.id));
   } catch (e) {

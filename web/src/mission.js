@@ -26,6 +26,8 @@ export class MissionPanel {
     this.scan = null; // {robot, state, fraction, message}
     this.stage = ''; // what happens to the newest scan after it was taken
     this.match = null;
+    this.matches = new Map(); // scan id -> match_done event seen by this page
+    this.corrections = new Map(); // scan id -> placed − estimated, from GET /api/v1/scans
     this.goalDistance = null;
     this.operator = false;
     this.bridges = 0;
@@ -67,6 +69,7 @@ export class MissionPanel {
 
   onMatchDone(e) {
     this.match = e;
+    this.matches.set(e.scan, e);
     this.stage = `scan ${e.scan} matched; building the map…`;
     this.render();
   }
@@ -74,6 +77,34 @@ export class MissionPanel {
   onMapUpdated(e) {
     this.stage = `scan ${e.scan} is in the map`;
     this.render();
+  }
+
+  /** Where matching placed each scan relative to its reported pose (GET /api/v1/scans). */
+  setScans(scans) {
+    this.corrections.clear();
+    for (const s of scans) {
+      const e = s.estimated;
+      const p = s.placed;
+      if (!e || !p) continue;
+      const dyaw = ((((p.yaw_deg - e.yaw_deg) % 360) + 540) % 360) - 180;
+      this.corrections.set(s.id, { shift: Math.hypot(p.x - e.x, p.y - e.y), dz: p.z - e.z, dyaw });
+    }
+    this.render();
+  }
+
+  /** One line per scan: the match result when this page saw it, else the correction on record. */
+  matchHistory() {
+    const ids = [...new Set([...this.corrections.keys(), ...this.matches.keys()])].sort((a, b) => a - b);
+    return ids.map((id) => {
+      const m = this.matches.get(id);
+      if (m) {
+        const c = m.correction || {};
+        return `scan ${id}: score ${f2(m.score)}, RMSE ${f2(m.rmse)} m, shift ${f2(Math.hypot(c.x || 0, c.y || 0))} m / ${f2(c.yaw_deg)}°, ${m.applied ? 'applied' : 'not applied'}`;
+      }
+      const c = this.corrections.get(id);
+      if (id === ids[0] && c.shift === 0 && c.dyaw === 0) return `scan ${id}: the reference`;
+      return `scan ${id}: placed ${f2(c.shift)} m / ${f2(c.dyaw)}° from its reported pose`;
+    });
   }
 
   /** Distance left to the goal of a move under way (or null). */
@@ -139,9 +170,11 @@ export class MissionPanel {
         `shift ${f2(shift)} m / ${f2(c.yaw_deg)}° — ${verdict}`;
       match.classList.toggle('warn', !m.applied);
     } else {
-      match.textContent = 'no scan matched in this page yet (the first scan is the reference)';
+      const history = this.matchHistory();
+      match.textContent = history.length > 1 ? `last match on record: ${history[history.length - 1]}` : 'the first scan is the reference; later ones are matched against the map';
       match.classList.remove('warn');
     }
+    match.title = this.matchHistory().join('\n');
     scanHere.hidden = !this.operator;
     scanHere.disabled = !this.bridges || (s && s.state === 'scanning');
     message.hidden = !message.textContent;
