@@ -6,8 +6,63 @@
 
 namespace scanplan::server {
 
+namespace {
+
+// The whole map is encoded again after every scan: Draco's speed 7 takes under half the time
+// of its default 5 for about the same size (tests/bench/draco_bench, docs/benchmarks.md).
+DracoOptions whole_map_options() {
+  DracoOptions o;
+  o.encode_speed = 7;
+  o.decode_speed = 7;
+  return o;
+}
+
+}  // namespace
+
 ScanStore::ScanStore(PipelineConfig pipeline, PlannerConfig planner)
-    : pipeline_(pipeline), planner_(planner) {}
+    : pipeline_(pipeline), planner_(planner), encoder_([this] { encode_loop(); }) {}
+
+ScanStore::~ScanStore() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  encode_wanted_.notify_all();
+  encoder_.join();
+}
+
+void ScanStore::encode_loop() {
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    encode_wanted_.wait(lock, [&] {
+      return stopping_ || (!scans_.empty() && encoded_last_scan_ != scans_.back().id);
+    });
+    if (stopping_) return;
+    const auto parts = placed_;
+    const std::int64_t last = scans_.back().id;
+    const std::size_t count = point_count_;
+    lock.unlock();
+    std::shared_ptr<const std::string> encoded;
+    try {
+      PointCloud all;
+      all.reserve(count);
+      for (const auto& p : parts) all.append(*p);
+      if (!all.empty())
+        encoded = std::make_shared<const std::string>(encode_draco(all, whole_map_options()));
+    } catch (const std::exception&) {
+      // Out of memory or a Draco failure: the previous encoding stays; readers see its
+      // last_scan and can fetch the rest with ?since.
+      lock.lock();
+      encoded_last_scan_ = last;
+      encoded_changed_.notify_all();
+      continue;
+    }
+    lock.lock();
+    encoded_ = std::move(encoded);
+    encoded_last_scan_ = last;
+    encoded_changed_.notify_all();
+  }
+}
 
 const std::vector<std::string>& ScanStore::layer_names() {
   static const std::vector<std::string> kNames = {"regions", "elevation", "movable"};
@@ -25,32 +80,26 @@ void ScanStore::add(const StoredScan& scan, const PointCloud& cloud) {
   }
 
   // Writers take turns on encode_mutex_; readers only wait for the short commit below, and
-  // they see the scan, its points and the map encoding that includes it appear together.
+  // they see the scan, its points, its chunk and the plan that includes it appear together.
   const Bounds3 added = bounds_of(placed);
   std::lock_guard encode_lock(encode_mutex_);
-  PointCloud next;
-  {
-    std::lock_guard lock(mutex_);
-    next = map_;
-  }
-  next.append(placed);
-  std::shared_ptr<const std::string> encoded, chunk;
-  if (!next.empty()) encoded = std::make_shared<const std::string>(encode_draco(next));
+  std::shared_ptr<const std::string> chunk;
   if (!placed.empty()) chunk = std::make_shared<const std::string>(encode_draco(placed));
+  auto shared = std::make_shared<const PointCloud>(std::move(placed));
 
   pipeline_.add_scan(cloud, pose);
   last_scan_ = {scan.id, scan.robot};
   refresh_derived([&] {
     scans_.push_back(scan);
-    offsets_.push_back(map_.size());
     chunks_[scan.id] = chunk;
-    map_ = std::move(next);
+    point_count_ += shared->size();
+    placed_.push_back(std::move(shared));
     if (added.valid()) {
       bounds_.extend(added.min);
       bounds_.extend(added.max);
     }
-    encoded_ = std::move(encoded);
   });
+  encode_wanted_.notify_one();
 }
 
 void ScanStore::refresh_derived(const std::function<void()>& commit) {
@@ -144,8 +193,10 @@ PointCloud ScanStore::points_near(double x, double y, double radius_m) const {
   PointCloud out;
   const Eigen::Vector2f c(static_cast<float>(x), static_cast<float>(y));
   const float r2 = static_cast<float>(radius_m * radius_m);
-  for (const auto& p : map_.points) {
-    if ((p.head<2>() - c).squaredNorm() <= r2) out.points.push_back(p);
+  for (const auto& part : placed_) {
+    for (const auto& p : part->points) {
+      if ((p.head<2>() - c).squaredNorm() <= r2) out.points.push_back(p);
+    }
   }
   return out;
 }
@@ -168,7 +219,7 @@ std::size_t ScanStore::scan_count() const {
 
 std::size_t ScanStore::point_count() const {
   std::lock_guard lock(mutex_);
-  return map_.size();
+  return point_count_;
 }
 
 Bounds3 ScanStore::bounds() const {
@@ -176,9 +227,12 @@ Bounds3 ScanStore::bounds() const {
   return bounds_;
 }
 
-ScanStore::EncodedMap ScanStore::encoded_map() const {
-  std::lock_guard lock(mutex_);
-  return {encoded_, scans_.empty() ? 0 : scans_.back().id};
+ScanStore::EncodedMap ScanStore::encoded_map(std::chrono::milliseconds wait) const {
+  std::unique_lock lock(mutex_);
+  if (scans_.empty()) return {};
+  encoded_changed_.wait_for(lock, wait,
+                            [&] { return stopping_ || encoded_last_scan_ == scans_.back().id; });
+  return {encoded_, encoded_last_scan_};
 }
 
 std::shared_ptr<const std::string> ScanStore::encoded_chunk(std::int64_t id) const {
@@ -190,6 +244,7 @@ std::shared_ptr<const std::string> ScanStore::encoded_chunk(std::int64_t id) con
 ScanStore::EncodedMap ScanStore::encoded_since(std::int64_t since_id) const {
   PointCloud tail;
   std::int64_t last = 0;
+  bool whole = false;
   {
     std::lock_guard lock(mutex_);
     if (scans_.empty()) return {};
@@ -202,12 +257,14 @@ ScanStore::EncodedMap ScanStore::encoded_since(std::int64_t since_id) const {
       }
     }
     if (first == scans_.size()) return {nullptr, last};
+    whole = first == 0;
     // The common case, one scan behind, is already encoded.
     if (first + 1 == scans_.size()) return {chunks_.at(scans_[first].id), last};
-    const std::size_t from = offsets_[first];
-    tail.points.assign(map_.points.begin() + from, map_.points.end());
-    tail.colors.assign(map_.colors.begin() + from, map_.colors.end());
+    if (!whole) {
+      for (std::size_t i = first; i < placed_.size(); ++i) tail.append(*placed_[i]);
+    }
   }
+  if (whole) return encoded_map();
   if (tail.empty()) return {nullptr, last};
   return {std::make_shared<const std::string>(encode_draco(tail)), last};
 }

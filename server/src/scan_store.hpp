@@ -1,11 +1,14 @@
 #pragma once
 
+#include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "scanplan/core/mapping_pipeline.hpp"
@@ -68,12 +71,17 @@ struct MissionParams {
   std::optional<TargetRegion> target;  // nothing: the pipeline's default square
 };
 
-// The scans of this session, in the map frame, with what is derived from them: the map's Draco
-// encoding, the MLS map with its regions, and the top-view layers as PNG. All of it is rebuilt
-// off the network thread each time a scan lands, so serving never waits on an encoder.
+// The scans of this session, in the map frame, with what is derived from them: each scan's
+// Draco chunk, the MLS map with its regions, the top-view layers as PNG and the plan, rebuilt
+// off the network thread each time a scan lands and published together. The whole map's Draco
+// encoding grows with the session (seconds for millions of points), so it is made on a thread
+// of its own after the scan is published: new candidates never wait for it.
 class ScanStore {
  public:
   explicit ScanStore(PipelineConfig pipeline = {}, PlannerConfig planner = {});
+  ~ScanStore();
+  ScanStore(const ScanStore&) = delete;
+  ScanStore& operator=(const ScanStore&) = delete;
 
   // A stored scan joins the map: `cloud` is in the scan's own frame, `scan.placed` puts it in
   // the map frame. Scans must come in id order.
@@ -90,7 +98,9 @@ class ScanStore {
     std::shared_ptr<const std::string> draco;  // null when there are no points
     std::int64_t last_scan = 0;                // the newest scan included
   };
-  EncodedMap encoded_map() const;
+  // The whole map's encoding. When the encoder is still behind the newest scan, waits for it
+  // up to `wait`; after that, the newest encoding there is (`last_scan` says which).
+  EncodedMap encoded_map(std::chrono::milliseconds wait = std::chrono::seconds(15)) const;
   // The points of the scans after `since_id` only: what a browser that already holds the map
   // up to that scan needs.
   EncodedMap encoded_since(std::int64_t since_id) const;
@@ -117,10 +127,16 @@ class ScanStore {
  private:
   mutable std::mutex mutex_;
   std::vector<StoredScan> scans_;
-  PointCloud map_;
-  Bounds3 bounds_;  // of map_, kept as scans arrive: the session endpoint is polled often
-  std::shared_ptr<const std::string> encoded_;
-  std::vector<std::size_t> offsets_;  // where each scan's points start in map_
+  // Each scan's points in the map frame, in the order of scans_: shared with the encoder
+  // thread, never copied whole.
+  std::vector<std::shared_ptr<const PointCloud>> placed_;
+  std::size_t point_count_ = 0;
+  Bounds3 bounds_;  // of all points, kept as scans arrive: the session endpoint is polled often
+  std::shared_ptr<const std::string> encoded_;  // the whole map up to encoded_last_scan_
+  std::int64_t encoded_last_scan_ = 0;
+  mutable std::condition_variable encoded_changed_;  // with mutex_
+  std::condition_variable encode_wanted_;            // with mutex_
+  bool stopping_ = false;
   std::map<std::int64_t, std::shared_ptr<const std::string>> chunks_;
   std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> layers_;
   MapAreas areas_;
@@ -131,6 +147,11 @@ class ScanStore {
   std::optional<PlanRecord> plan_;
   std::map<std::string, RobotState> robots_;
   mutable std::mutex encode_mutex_;  // one writer at a time; readers keep the previous result
+  std::thread encoder_;              // last member: starts once everything else exists
+
+  // The encoder thread: encodes the whole map whenever a scan has joined since the last time
+  // (several scans that arrived meanwhile in one go).
+  void encode_loop();
 
   // Recomputes layers, areas and the plan from the pipeline and publishes them together with
   // whatever `commit` changes (run under mutex_); needs encode_mutex_ held.
