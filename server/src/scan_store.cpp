@@ -6,19 +6,6 @@
 
 namespace scanplan::server {
 
-namespace {
-
-// The whole map is encoded again after every scan: Draco's speed 7 takes under half the time
-// of its default 5 for about the same size (tests/bench/draco_bench, docs/benchmarks.md).
-DracoOptions whole_map_options() {
-  DracoOptions o;
-  o.encode_speed = 7;
-  o.decode_speed = 7;
-  return o;
-}
-
-}  // namespace
-
 ScanStore::ScanStore(PipelineConfig pipeline, PlannerConfig planner)
     : pipeline_(pipeline), planner_(planner), encoder_([this] { encode_loop(); }) {}
 
@@ -47,8 +34,7 @@ void ScanStore::encode_loop() {
       PointCloud all;
       all.reserve(count);
       for (const auto& p : parts) all.append(*p);
-      if (!all.empty())
-        encoded = std::make_shared<const std::string>(encode_draco(all, whole_map_options()));
+      if (!all.empty()) encoded = std::make_shared<const std::string>(encode_draco(all));
     } catch (const std::exception&) {
       // Out of memory or a Draco failure: the previous encoding stays; readers see its
       // last_scan and can fetch the rest with ?since.

@@ -1,14 +1,16 @@
-// Draco encoding of a growing campus map (the server encodes every scan's points and serves
-// the whole map): time and size per point for Draco's speed settings, against the raw size of
-// the same points (float32 xyz + uint8 rgb, 15 bytes a point). Prints one JSON line.
+// Draco encoding of a campus map of SCANS scans coloured from their panoramas (the server
+// encodes every scan's points and serves the whole map): time and size per point for Draco's
+// speed settings, against the raw size of the same points (float32 xyz + uint8 rgb, 15 bytes a
+// point). Prints one JSON line.
 // Usage: draco_bench [SCANS]
 #include <chrono>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "scanplan/core/colorizer.hpp"
 #include "scanplan/core/draco_codec.hpp"
-#include "scanplan/core/simulated_scanner.hpp"
+#include "scanplan/core/simulated_shot.hpp"
 #include "scanplan/core/world.hpp"
 
 int main(int argc, char** argv) {
@@ -22,10 +24,13 @@ int main(int argc, char** argv) {
     p.x = 30 + (k * 37) % 140;
     p.y = 20 + (k * 23) % 120;
     p.z = world.ground_height(p.x, p.y);
-    const PointCloud scan =
-        simulate_scan(caster, world.scanner, p, static_cast<std::uint64_t>(k + 1));
+    // Coloured from the panorama as the server colours them: the colours weigh in the size.
+    auto shot = simulate_shot(caster, world.scanner, p, static_cast<std::uint64_t>(k + 1));
+    colorize(shot->cloud, shot->panorama, shot->camera);
     const Eigen::Affine3f T = p.isometry().cast<float>();
-    for (const auto& q : scan.points) map.push_back(T * q, Rgb{100, 150, 200});
+    for (std::size_t i = 0; i < shot->cloud.size(); ++i)
+      map.push_back(T * shot->cloud.points[i],
+                    shot->cloud.has_colors() ? shot->cloud.colors[i] : Rgb{128, 128, 128});
   }
   nlohmann::json out = {{"bench", "draco_campus_map"},
                         {"scans", scans},
