@@ -69,20 +69,19 @@ StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
       scan.estimated, *matching_);
   const Pose& e = scan.estimated;
   const Pose& p = m.placed;
-  events_.publish("match_done",
-                  {{"scan", scan.id},
-                   {"method", m.result.method},
-                   {"converged", m.result.converged},
-                   {"applied", m.applied},
-                   {"score", m.result.score},
-                   {"rmse", m.result.rmse},
-                   {"time_ms", m.result.time_ms},
-                   {"message", m.result.message},
-                   {"correction",
-                    {{"x", p.x - e.x},
-                     {"y", p.y - e.y},
-                     {"z", p.z - e.z},
-                     {"yaw_deg", rad2deg(std::remainder(p.yaw - e.yaw, 2 * M_PI))}}}});
+  events_.publish("match_done", {{"scan", scan.id},
+                                 {"method", m.result.method},
+                                 {"converged", m.result.converged},
+                                 {"applied", m.applied},
+                                 {"score", m.result.score},
+                                 {"rmse", m.result.rmse},
+                                 {"time_ms", m.result.time_ms},
+                                 {"message", m.result.message},
+                                 {"correction",
+                                  {{"x", p.x - e.x},
+                                   {"y", p.y - e.y},
+                                   {"z", p.z - e.z},
+                                   {"yaw_deg", rad2deg(std::remainder(p.yaw - e.yaw, 2 * M_PI))}}}});
   if (!m.applied) {
     spdlog::warn("scan {} stays at its reported pose: {}", scan.id, m.result.message);
     return scan;
