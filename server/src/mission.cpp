@@ -107,7 +107,7 @@ json Mission::cancel(std::uint64_t id, const std::string& by) {
   moving_.erase(it);
   store_.set_candidate_state(id, "cancelled");
   // The robot's goal is now where it stands; the old one must not linger on the latched topic.
-  dds_.publish_goal(here);
+  if (rs != states.end()) dds_.publish_goal(here);
   const json out = {{"candidate", id}, {"robot", robot}, {"by", by}};
   record("cancel", out);
   return out;
