@@ -74,6 +74,10 @@ std::unique_ptr<dds_qos_t, QosDeleter> make_qos(QosKind kind) {
     case QosKind::kStatus:
       dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, 1);
       break;
+    case QosKind::kLatched:
+      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, 1);
+      dds_qset_durability(q.get(), DDS_DURABILITY_TRANSIENT_LOCAL);
+      break;
   }
   return q;
 }

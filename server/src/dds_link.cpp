@@ -8,6 +8,7 @@
 #include "scanplan/core/image_codec.hpp"
 #include "scanplan/msgs/camera_info.hpp"
 #include "scanplan/msgs/pointcloud2.hpp"
+#include "scanplan/msgs/pose_array.hpp"
 #include "scanplan/msgs/pose_stamped.hpp"
 #include "scanplan/msgs/topics.hpp"
 
@@ -22,6 +23,12 @@ constexpr auto kPartialExpiry = std::chrono::seconds(60);
 
 std::string str(const char* s) {
   return s ? s : "";
+}
+
+std::int64_t now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
 }
 
 }  // namespace
@@ -43,6 +50,16 @@ DdsLink::DdsLink(std::uint32_t domain_id, ScanStore& store, ScanIntake& intake,
   status_reader_ = p.reader(scanplan_RobotStatus_desc, topics::kRobotStatus, QosKind::kStatus);
   scan_cmd_writer_ = p.writer(scanplan_ScanCommand_desc, topics::kScanCommand, QosKind::kCommand);
   move_cmd_writer_ = p.writer(scanplan_MoveCommand_desc, topics::kMoveCommand, QosKind::kCommand);
+  // Latched (reliable, keep last 1, transient-local): each new map, plan or goal supersedes the
+  // last, and a viewer or ROS node that joins mid-mission must get the current one without
+  // waiting for the next scan or approval, which may be minutes away.
+  map_writer_ = p.writer(sensor_msgs_msg_dds__PointCloud2__desc, topics::kMap, QosKind::kLatched);
+  candidates_writer_ =
+      p.writer(geometry_msgs_msg_dds__PoseArray__desc, topics::kCandidates, QosKind::kLatched);
+  goal_writer_ =
+      p.writer(geometry_msgs_msg_dds__PoseStamped__desc, topics::kGoal, QosKind::kLatched);
+  // Keyed by id, so keep-last 1 is per annotation: a late joiner gets every live one.
+  annotation_writer_ = p.writer(scanplan_Annotation_desc, topics::kAnnotation, QosKind::kLatched);
 }
 
 DdsLink::~DdsLink() {
@@ -86,6 +103,78 @@ std::uint32_t DdsLink::request_move(const std::string& robot_id, double x, doubl
   cmd.yaw_deg = yaw_deg;
   dds::check(dds_write(move_cmd_writer_, &cmd), "sending the move command");
   return cmd.command_id;
+}
+
+void DdsLink::publish_map(const PointCloud& map_points) {
+  try {
+    const dds::PackedPointCloud2 msg(map_points, topics::kMapFrame, now_ns());
+    dds::check(dds_write(map_writer_, &msg.msg()),
+               "publishing the map on " + std::string(topics::kMap));
+  } catch (const std::exception& e) {
+    spdlog::error("the map ({} points) was not published: {}", map_points.size(), e.what());
+  }
+}
+
+void DdsLink::publish_candidates(const PlanRecord& plan) {
+  try {
+    std::vector<Pose> poses;
+    for (const CandidateRecord& r : plan.candidates) {
+      Pose p;
+      p.x = r.candidate.position.x();
+      p.y = r.candidate.position.y();
+      p.z = r.candidate.position.z();
+      p.yaw = deg2rad(approach_yaw_deg(r.candidate));
+      poses.push_back(p);
+    }
+    dds::OwnedPoseArray msg;
+    dds::to_pose_array(poses, topics::kMapFrame, now_ns(), msg);
+    dds::check(dds_write(candidates_writer_, &msg.msg),
+               "publishing the candidates on " + std::string(topics::kCandidates));
+  } catch (const std::exception& e) {
+    spdlog::error("the candidates of plan {} were not published: {}", plan.id, e.what());
+  }
+}
+
+void DdsLink::publish_goal(const Pose& goal) {
+  try {
+    dds::OwnedPoseStamped msg;
+    dds::to_pose_stamped(goal, topics::kMapFrame, now_ns(), msg);
+    dds::check(dds_write(goal_writer_, &msg.msg),
+               "publishing the goal on " + std::string(topics::kGoal));
+  } catch (const std::exception& e) {
+    spdlog::error("the goal ({:.2f}, {:.2f}) was not published: {}", goal.x, goal.y, e.what());
+  }
+}
+
+void DdsLink::publish_annotation(const Annotation& a) {
+  try {
+    scanplan_Annotation msg{};
+    msg.id = a.id;
+    msg.kind = const_cast<char*>(a.kind.c_str());
+    msg.position = {a.x, a.y, a.z};
+    msg.text = const_cast<char*>(a.text.c_str());
+    msg.author = const_cast<char*>(a.author.c_str());
+    msg.stamp = dds::to_stamp(a.created_ns);
+    dds::check(dds_write(annotation_writer_, &msg),
+               "publishing annotation " + std::to_string(a.id));
+  } catch (const std::exception& e) {
+    spdlog::error("annotation {} was not published: {}", a.id, e.what());
+  }
+}
+
+void DdsLink::withdraw_annotation(std::int64_t id) {
+  try {
+    scanplan_Annotation key{};
+    key.id = id;
+    key.kind = key.text = key.author = const_cast<char*>("");
+    // Disposed: readers learn it is gone. Unregistered: the writer drops the instance from the
+    // history it keeps for late joiners.
+    dds::check(dds_dispose(annotation_writer_, &key), "disposing annotation " + std::to_string(id));
+    dds::check(dds_unregister_instance(annotation_writer_, &key),
+               "unregistering annotation " + std::to_string(id));
+  } catch (const std::exception& e) {
+    spdlog::error("the deletion of annotation {} was not published: {}", id, e.what());
+  }
 }
 
 int DdsLink::connected_bridges() const {

@@ -28,7 +28,8 @@ class NoScannerError : public std::runtime_error {
 
 // The server's side of DDS: receives scans, poses, panoramas, progress and status from bridges
 // on its own thread, colourises each scan from its panorama and hands it to the store; sends
-// commands on behalf of the API.
+// commands on behalf of the API; publishes the map, the plan, the approved goal and the
+// annotations to anyone (ROS 2 nodes included) on latched topics (docs/dds.md).
 class DdsLink {
  public:
   DdsLink(std::uint32_t domain_id, ScanStore& store, ScanIntake& intake, const Events& events);
@@ -47,6 +48,19 @@ class DdsLink {
   std::uint32_t request_move(const std::string& robot_id, double x, double y, double yaw_deg);
   // Bridges currently subscribed to scan commands.
   int connected_bridges() const;
+  // Server → anyone. Thread-safe; each logs rather than throws when DDS refuses the sample,
+  // since what it announces is already stored and the caller's work must not fail over it.
+  //
+  // The thinned map in the map frame (PointCloud2, x y z float32 + rgb).
+  void publish_map(const PointCloud& map_points);
+  // The plan's candidates, best first, each facing the way the robot would arrive (PoseArray).
+  void publish_candidates(const PlanRecord& plan);
+  // Where the operator sent a robot (PoseStamped).
+  void publish_goal(const Pose& goal);
+  void publish_annotation(const Annotation& annotation);
+  // Disposes and unregisters a deleted annotation, so late joiners no longer get it.
+  void withdraw_annotation(std::int64_t id);
+
   // Called on the DDS thread with every status a robot reports (set before start()).
   std::function<void(const std::string& robot, const RobotStatus& status)> on_status;
 
@@ -73,7 +87,8 @@ class DdsLink {
   const Events& events_;
   dds::Participant participant_;
   dds_entity_t points_reader_, pose_reader_, image_reader_, camera_info_reader_, progress_reader_,
-      status_reader_, scan_cmd_writer_, move_cmd_writer_;
+      status_reader_, scan_cmd_writer_, move_cmd_writer_, map_writer_, candidates_writer_,
+      goal_writer_, annotation_writer_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
   std::mutex command_mutex_;

@@ -48,13 +48,7 @@ json Mission::approve(std::uint64_t id, const std::string& by) {
     throw MissionError(409, "conflict",
                        "robot '" + robot + "' is still carrying out an approved move");
   }
-  // Face along the last leg of the path, so the scan starts looking where the robot went.
-  double yaw_deg = 0;
-  const auto& path = c.candidate.path;
-  if (path.size() >= 2) {
-    const Eigen::Vector2d d = path.back() - path[path.size() - 2];
-    yaw_deg = rad2deg(std::atan2(d.y(), d.x()));
-  }
+  const double yaw_deg = approach_yaw_deg(c.candidate);
   std::uint32_t command = 0;
   try {
     command = dds_.request_move(robot, c.candidate.position.x(), c.candidate.position.y(), yaw_deg);
@@ -63,6 +57,12 @@ json Mission::approve(std::uint64_t id, const std::string& by) {
   }
   moving_[robot] = {command, id};
   store_.set_candidate_state(id, "moving");
+  Pose goal;
+  goal.x = c.candidate.position.x();
+  goal.y = c.candidate.position.y();
+  goal.z = c.candidate.position.z();
+  goal.yaw = deg2rad(yaw_deg);
+  dds_.publish_goal(goal);
   const json out = {{"candidate", id},
                     {"robot", robot},
                     {"command_id", command},
@@ -106,6 +106,8 @@ json Mission::cancel(std::uint64_t id, const std::string& by) {
   }
   moving_.erase(it);
   store_.set_candidate_state(id, "cancelled");
+  // The robot's goal is now where it stands; the old one must not linger on the latched topic.
+  if (rs != states.end()) dds_.publish_goal(here);
   const json out = {{"candidate", id}, {"robot", robot}, {"by", by}};
   record("cancel", out);
   return out;

@@ -1,10 +1,19 @@
 #include "scan_store.hpp"
 
+#include <cmath>
+
 #include "scanplan/core/draco_codec.hpp"
 #include "scanplan/core/plan_view.hpp"
 #include "scanplan/core/top_view.hpp"
 
 namespace scanplan::server {
+
+double approach_yaw_deg(const Candidate& c) {
+  const auto& path = c.path;
+  if (path.size() < 2) return 0;
+  const Eigen::Vector2d d = path.back() - path[path.size() - 2];
+  return rad2deg(std::atan2(d.y(), d.x()));
+}
 
 ScanStore::ScanStore(PipelineConfig pipeline, PlannerConfig planner)
     : pipeline_(pipeline), planner_(planner), encoder_([this] { encode_loop(); }) {}
@@ -73,9 +82,10 @@ void ScanStore::add(const StoredScan& scan, const PointCloud& cloud) {
   if (!placed.empty()) chunk = std::make_shared<const std::string>(encode_draco(placed));
   auto shared = std::make_shared<const PointCloud>(std::move(placed));
 
+  thinned_.add(*shared);
   pipeline_.add_scan(cloud, pose);
   last_scan_ = {scan.id, scan.robot};
-  refresh_derived([&] {
+  const auto plan = refresh_derived([&] {
     scans_.push_back(scan);
     chunks_[scan.id] = chunk;
     point_count_ += shared->size();
@@ -86,13 +96,17 @@ void ScanStore::add(const StoredScan& scan, const PointCloud& cloud) {
     }
   });
   encode_wanted_.notify_one();
+  // Outside mutex_ so readers are not held up, inside encode_mutex_ so maps and plans go out in
+  // the order they were made; the map first, as the plan is made from it.
+  if (on_map) on_map(thinned_.cloud());
+  if (plan && on_plan) on_plan(*plan);
 }
 
-void ScanStore::refresh_derived(const std::function<void()>& commit) {
+std::optional<PlanRecord> ScanStore::refresh_derived(const std::function<void()>& commit) {
   if (!pipeline_.regions() || !pipeline_.movable()) {
     std::lock_guard lock(mutex_);
     if (commit) commit();
-    return;
+    return std::nullopt;
   }
   const RegionMap& regions = *pipeline_.regions();
   const MovableRegion& movable = *pipeline_.movable();
@@ -129,17 +143,20 @@ void ScanStore::refresh_derived(const std::function<void()>& commit) {
   const MapAreas areas{regions.completed_m2(), regions.low_resolution_m2(), regions.unscanned_m2(),
                        movable.area_m2()};
 
-  // The scan, its map and everything derived from it appear to readers together.
-  std::lock_guard lock(mutex_);
-  if (commit) commit();
-  if (plan_) {
-    for (auto& c : plan_->candidates) {
-      if (c.state == "proposed") c.state = "superseded";
+  {
+    // The scan, its map and everything derived from it appear to readers together.
+    std::lock_guard lock(mutex_);
+    if (commit) commit();
+    if (plan_) {
+      for (auto& c : plan_->candidates) {
+        if (c.state == "proposed") c.state = "superseded";
+      }
     }
+    plan_ = record;
+    layers_ = std::move(layers);
+    areas_ = areas;
   }
-  plan_ = std::move(record);
-  layers_ = std::move(layers);
-  areas_ = areas;
+  return record;
 }
 
 std::optional<PlanRecord> ScanStore::plan() const {
@@ -171,7 +188,8 @@ void ScanStore::set_params(const MissionParams& params) {
   planner_ = params.planner;
   pipeline_.set_region_configs(params.planner.regions, params.planner.movable);
   if (params.target) pipeline_.set_target(*params.target);
-  refresh_derived({});
+  const auto plan = refresh_derived({});
+  if (plan && on_plan) on_plan(*plan);
 }
 
 PointCloud ScanStore::points_near(double x, double y, double radius_m) const {

@@ -16,6 +16,7 @@
 #include "scanplan/core/pose.hpp"
 #include "scanplan/core/scan_planner.hpp"
 #include "scanplan/core/session_store.hpp"
+#include "scanplan/core/voxel_filter.hpp"
 
 namespace scanplan::server {
 
@@ -65,6 +66,10 @@ struct PlanRecord {
   std::vector<CandidateRecord> candidates;
 };
 
+// The heading a robot takes at candidate `c`: along the last leg of its path, so the scan starts
+// looking where the robot went (0 without a path). Degrees, map frame.
+double approach_yaw_deg(const Candidate& c);
+
 // What the operator can change while the mission runs (PUT /api/v1/params).
 struct MissionParams {
   PlannerConfig planner;
@@ -82,6 +87,18 @@ class ScanStore {
   ~ScanStore();
   ScanStore(const ScanStore&) = delete;
   ScanStore& operator=(const ScanStore&) = delete;
+
+  // Side of the cubes the map is thinned to for subscribers who take the whole map at once
+  // (DDS rt/scanplan/map): 0.3 m keeps walls, doorways and cars recognisable, and the yard
+  // after a scan, or a campus block, stays within a few MB a message.
+  static constexpr double kThinnedMapVoxelM = 0.3;
+
+  // Told of each new thinned map (map frame, coloured, kThinnedMapVoxelM) and each new plan, in
+  // the order they were made, on the thread that made them (the intake worker, or the one
+  // changing parameters). Set them before the first add(). They run while the store's writers
+  // wait, so they must be quick and must not call add() or the params functions.
+  std::function<void(const PointCloud& thinned_map)> on_map;
+  std::function<void(const PlanRecord& plan)> on_plan;
 
   // A stored scan joins the map: `cloud` is in the scan's own frame, `scan.placed` puts it in
   // the map frame. Scans must come in id order.
@@ -137,6 +154,7 @@ class ScanStore {
   mutable std::condition_variable encoded_changed_;  // with mutex_
   std::condition_variable encode_wanted_;            // with mutex_
   bool stopping_ = false;
+  VoxelMap thinned_{kThinnedMapVoxelM};  // under encode_mutex_
   std::map<std::int64_t, std::shared_ptr<const std::string>> chunks_;
   std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> layers_;
   MapAreas areas_;
@@ -154,8 +172,9 @@ class ScanStore {
   void encode_loop();
 
   // Recomputes layers, areas and the plan from the pipeline and publishes them together with
-  // whatever `commit` changes (run under mutex_); needs encode_mutex_ held.
-  void refresh_derived(const std::function<void()>& commit);
+  // whatever `commit` changes (run under mutex_); needs encode_mutex_ held. Returns the new plan
+  // (nothing when there is no map to plan on yet).
+  std::optional<PlanRecord> refresh_derived(const std::function<void()>& commit);
 };
 
 }  // namespace scanplan::server

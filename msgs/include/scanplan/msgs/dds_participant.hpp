@@ -30,6 +30,11 @@ enum class QosKind {
   kScanData,  // reliable, keep the last few: scans are large and each one matters
   kCommand,   // reliable, keep all (bounded): a lost command is a robot that never moves
   kStatus,    // reliable, keep last 1: a newer status supersedes the older
+  // reliable, keep last 1 (per instance for keyed types), transient-local: state that supersedes
+  // itself and that a subscriber joining later must still get (the map, the plan, the goal, the
+  // annotations), as a ROS 1 "latched" topic. Readers must ask for transient-local too to be
+  // given the history.
+  kLatched,
 };
 
 class Participant {
