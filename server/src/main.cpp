@@ -79,6 +79,8 @@ int main(int argc, char** argv) {
     dds.on_status = [&mission](const std::string& robot, const srv::RobotStatus& status) {
       mission.on_status(robot, status);
     };
+    dds.on_robot_lost = [&mission](const srv::RobotLoss& loss) { mission.on_robot_lost(loss); };
+    dds.on_robot_back = [&mission](const std::string& robot) { mission.on_robot_back(robot); };
     srv::Api api(store, intake, dds, mission, auth, session_dir);
     http::Router router([](std::string_view msg) { spdlog::error("{}", msg); });
     api.install(router);
