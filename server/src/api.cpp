@@ -160,7 +160,11 @@ Response Api::session() const {
   const std::optional<StoredScan> last = store_.last_scan();
   json robots = json::object();
   for (const auto& [id, r] : store_.robot_states()) {
-    robots[id] = {{"state", r.status.state},
+    const bool connected = r.connection.connected;
+    robots[id] = {{"connected", connected},
+                  {"lost_at", connected ? json(nullptr) : json(r.connection.lost_at)},
+                  {"lost_reason", connected ? json(nullptr) : json(r.connection.reason)},
+                  {"state", r.status.state},
                   {"command_id", r.status.command_id},
                   {"message", r.status.message},
                   {"pose", pose_json(r.status.reported)},

@@ -101,6 +101,8 @@ int main(int argc, char** argv) {
     store.on_map = [&dds](const scanplan::PointCloud& map) { dds.publish_map(map); };
     store.on_plan = [&dds](const srv::PlanRecord& plan) { dds.publish_candidates(plan); };
     annotations.republish();
+    dds.on_robot_lost = [&mission](const srv::RobotLoss& loss) { mission.on_robot_lost(loss); };
+    dds.on_robot_back = [&mission](const std::string& robot) { mission.on_robot_back(robot); };
     srv::Api api(store, intake, dds, mission, annotations, auth, session_dir);
     http::Router router([](std::string_view msg) { spdlog::error("{}", msg); });
     api.install(router);

@@ -295,6 +295,11 @@ void ScanStore::set_robot_status(const std::string& robot_id, RobotStatus status
   robots_[robot_id].status = std::move(status);
 }
 
+void ScanStore::set_robot_connection(const std::string& robot_id, RobotConnection connection) {
+  std::lock_guard lock(mutex_);
+  robots_[robot_id].connection = std::move(connection);
+}
+
 std::map<std::string, RobotState> ScanStore::robot_states() const {
   std::lock_guard lock(mutex_);
   return robots_;

@@ -36,9 +36,17 @@ struct RobotStatus {
   Pose reported;
 };
 
+// Whether the robot's bridge is alive on DDS (its liveliness lease, docs/dds.md).
+struct RobotConnection {
+  bool connected = true;
+  std::string lost_at;  // UTC, ISO 8601; empty while connected
+  std::string reason;   // why it was lost; empty while connected
+};
+
 struct RobotState {
   RobotStatus status;
   RobotScanState scan;
+  RobotConnection connection;
 };
 
 // Areas of the target region's C / M / U segmentation and of the movable region (m²).
@@ -139,6 +147,7 @@ class ScanStore {
 
   void set_scan_state(const std::string& robot_id, RobotScanState state);
   void set_robot_status(const std::string& robot_id, RobotStatus status);
+  void set_robot_connection(const std::string& robot_id, RobotConnection connection);
   std::map<std::string, RobotState> robot_states() const;
 
  private:
