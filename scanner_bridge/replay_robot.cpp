@@ -49,6 +49,7 @@ void ReplayRobot::run(const std::atomic<bool>& stop) {
       }
     }
   }
+  publisher_.goodbye(current_pose());
 }
 
 void ReplayRobot::scan(std::uint32_t command_id, const std::atomic<bool>& stop) {

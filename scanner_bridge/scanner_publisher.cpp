@@ -61,6 +61,12 @@ void ScannerPublisher::status(std::uint32_t command_id, const std::string& state
   dds::check(dds_write(status_, &m), "publishing robot status");
 }
 
+void ScannerPublisher::goodbye(const Pose& reported) {
+  status(0, "offline", reported, "scanplan-bridge was stopped");
+  // Cyclone lingers on deleting a reliable writer until its data is acknowledged (up to 1 s),
+  // so the goodbye reaches the server before the participant disappears.
+}
+
 void ScannerPublisher::scan(const PointCloud& cloud, const Pose& reported,
                             const std::optional<CameraShot>& shot) {
   const std::int64_t stamp = now_ns();

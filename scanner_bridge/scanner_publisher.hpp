@@ -28,6 +28,9 @@ class ScannerPublisher {
                 const std::string& message = "");
   void status(std::uint32_t command_id, const std::string& state, const Pose& reported,
               const std::string& message = "");
+  // The last status before the bridge stops: the server then reports the robot lost at once and
+  // as shut down, where otherwise it could only see the writers vanish (as when killed).
+  void goodbye(const Pose& reported);
   // Camera first, then pose, then points, all with one stamp: the server pairs them by it and
   // colourises when the image is there before the points.
   void scan(const PointCloud& cloud_robot_frame, const Pose& reported,

@@ -54,6 +54,7 @@ void SimulatedRobot::run(const std::atomic<bool>& stop) {
       last_status = std::chrono::steady_clock::now();
     }
   }
+  publisher_.goodbye(reported_);
 }
 
 void SimulatedRobot::scan(std::uint32_t command_id, const std::atomic<bool>& stop) {

@@ -4,8 +4,10 @@
 #include <sqlite3.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <ctime>
 #include <set>
@@ -15,8 +17,7 @@
 namespace scanplan {
 namespace {
 
-std::string utc_now() {
-  const auto now = std::chrono::system_clock::now();
+std::string utc_iso(std::chrono::system_clock::time_point now) {
   const std::time_t t = std::chrono::system_clock::to_time_t(now);
   const auto ms =
       std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
@@ -27,6 +28,10 @@ std::string utc_now() {
   char out[48];
   std::snprintf(out, sizeof out, "%s.%03dZ", buf, static_cast<int>(ms));
   return out;
+}
+
+std::string utc_now() {
+  return utc_iso(std::chrono::system_clock::now());
 }
 
 // Writes `bytes` to `path` so that after return the file is whole on disk under its name:
@@ -141,6 +146,13 @@ SessionStore::SessionStore(std::filesystem::path dir) : dir_(std::move(dir)) {
   exec(
       "CREATE TABLE IF NOT EXISTS events(id INTEGER PRIMARY KEY, at TEXT NOT NULL, "
       "kind TEXT NOT NULL, json TEXT NOT NULL)");
+  // Deleted annotations keep their rows (deleted_at, deleted_by set): what was marked on the map
+  // and withdrawn is part of a rescue's record, and ids are never reused.
+  exec(
+      "CREATE TABLE IF NOT EXISTS annotations(id INTEGER PRIMARY KEY, kind TEXT NOT NULL, "
+      "x REAL NOT NULL, y REAL NOT NULL, z REAL NOT NULL, text TEXT NOT NULL, "
+      "author TEXT NOT NULL, created_ns INTEGER NOT NULL, created_at TEXT NOT NULL, "
+      "deleted_at TEXT, deleted_by TEXT)");
   remove_orphans();
 }
 
@@ -254,6 +266,75 @@ std::int64_t SessionStore::append_event(const std::string& kind, const std::stri
   s.bind(1, utc_now()).bind(2, kind).bind(3, json);
   s.step();
   return sqlite3_last_insert_rowid(db_);
+}
+
+Annotation SessionStore::add_annotation(const std::string& kind, double x, double y, double z,
+                                        const std::string& text, const std::string& author) {
+  if (std::find(kAnnotationKinds.begin(), kAnnotationKinds.end(), kind) == kAnnotationKinds.end()) {
+    throw SessionStoreError("unknown annotation kind '" + kind +
+                            "': it is victim, hazard, blocked or note");
+  }
+  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+    throw SessionStoreError("an annotation's coordinates must be finite numbers");
+  }
+  if (text.size() > kMaxAnnotationTextBytes || author.size() > kMaxAnnotationAuthorBytes) {
+    throw SessionStoreError("an annotation's text is limited to " +
+                            std::to_string(kMaxAnnotationTextBytes) + " bytes and its author to " +
+                            std::to_string(kMaxAnnotationAuthorBytes));
+  }
+  const auto now = std::chrono::system_clock::now();
+  Annotation a;
+  a.kind = kind;
+  a.x = x;
+  a.y = y;
+  a.z = z;
+  a.text = text;
+  a.author = author;
+  a.created_ns =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(now.time_since_epoch()).count();
+  a.created_at = utc_iso(now);
+  std::lock_guard lock(mutex_);
+  // One statement in autocommit mode: with WAL and synchronous=FULL it is durable on return.
+  Statement s(db_,
+              "INSERT INTO annotations(kind, x, y, z, text, author, created_ns, created_at) "
+              "VALUES(?, ?, ?, ?, ?, ?, ?, ?)");
+  s.bind(1, kind).bind(2, x).bind(3, y).bind(4, z).bind(5, text).bind(6, author);
+  s.bind(7, a.created_ns).bind(8, a.created_at);
+  s.step();
+  a.id = sqlite3_last_insert_rowid(db_);
+  return a;
+}
+
+bool SessionStore::delete_annotation(std::int64_t id, const std::string& by) {
+  std::lock_guard lock(mutex_);
+  Statement s(db_,
+              "UPDATE annotations SET deleted_at = ?, deleted_by = ? "
+              "WHERE id = ? AND deleted_at IS NULL");
+  s.bind(1, utc_now()).bind(2, by).bind(3, id);
+  s.step();
+  return sqlite3_changes(db_) > 0;
+}
+
+std::vector<Annotation> SessionStore::annotations() const {
+  std::lock_guard lock(mutex_);
+  std::vector<Annotation> out;
+  Statement s(db_,
+              "SELECT id, kind, x, y, z, text, author, created_ns, created_at FROM annotations "
+              "WHERE deleted_at IS NULL ORDER BY id");
+  while (s.step()) {
+    Annotation a;
+    a.id = s.integer(0);
+    a.kind = s.text(1);
+    a.x = s.real(2);
+    a.y = s.real(3);
+    a.z = s.real(4);
+    a.text = s.text(5);
+    a.author = s.text(6);
+    a.created_ns = s.integer(7);
+    a.created_at = s.text(8);
+    out.push_back(std::move(a));
+  }
+  return out;
 }
 
 }  // namespace scanplan

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -23,17 +25,10 @@ bool voxel_key(const Eigen::Vector3f& p, double inv, std::uint64_t& key) {
   return true;
 }
 
-}  // namespace
-
-PointCloud voxel_downsample(const PointCloud& cloud, double voxel_m) {
-  PointCloud out;
-  if (!(voxel_m > 0)) {
-    out.points.reserve(cloud.size());
-    for (const auto& p : cloud.points) {
-      if (p.allFinite()) out.points.push_back(p);
-    }
-    return out;
-  }
+// For each occupied voxel of side voxel_m > 0, its key and the index of the measured point
+// nearest the centroid of the voxel's points; sorted by key.
+std::vector<std::pair<std::uint64_t, std::uint32_t>> representatives(const PointCloud& cloud,
+                                                                     double voxel_m) {
   const double inv = 1.0 / voxel_m;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
   keyed.reserve(cloud.size());
@@ -44,6 +39,7 @@ PointCloud voxel_downsample(const PointCloud& cloud, double voxel_m) {
     }
   }
   std::sort(keyed.begin(), keyed.end());
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> out;
   for (std::size_t begin = 0; begin < keyed.size();) {
     std::size_t end = begin;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -58,10 +54,69 @@ PointCloud voxel_downsample(const PointCloud& cloud, double voxel_m) {
       const double d = (cloud.points[keyed[k].second].cast<double>() - centroid).squaredNorm();
       if (d < nearest_sq) nearest_sq = d, nearest = k;
     }
-    out.points.push_back(cloud.points[keyed[nearest].second]);
+    out.push_back(keyed[nearest]);
     begin = end;
   }
   return out;
+}
+
+}  // namespace
+
+PointCloud voxel_downsample(const PointCloud& cloud, double voxel_m) {
+  PointCloud out;
+  if (!(voxel_m > 0)) {
+    out.points.reserve(cloud.size());
+    for (const auto& p : cloud.points) {
+      if (p.allFinite()) out.points.push_back(p);
+    }
+    return out;
+  }
+  const auto reps = representatives(cloud, voxel_m);
+  out.points.reserve(reps.size());
+  for (const auto& [key, index] : reps) out.points.push_back(cloud.points[index]);
+  return out;
+}
+
+VoxelMap::VoxelMap(double voxel_m) : voxel_m_(voxel_m) {
+  if (!(voxel_m > 0) || !std::isfinite(voxel_m)) {
+    throw std::invalid_argument("a voxel map needs a voxel size > 0 m, got " +
+                                std::to_string(voxel_m));
+  }
+}
+
+void VoxelMap::add(const PointCloud& cloud) {
+  const auto reps = representatives(cloud, voxel_m_);
+  if (reps.empty()) return;
+  const bool colored = cloud.has_colors();
+  // Both lists are sorted by key: one merge pass, linear in the map's size.
+  std::vector<std::uint64_t> keys;
+  PointCloud merged;
+  keys.reserve(keys_.size() + reps.size());
+  merged.reserve(keys_.size() + reps.size());
+  std::size_t i = 0, j = 0;
+  const auto take_new = [&] {
+    const std::uint32_t k = reps[j].second;
+    keys.push_back(reps[j].first);
+    merged.push_back(cloud.points[k], colored ? cloud.colors[k] : kUncolored);
+    ++j;
+  };
+  const auto take_old = [&] {
+    keys.push_back(keys_[i]);
+    merged.push_back(cloud_.points[i], cloud_.colors[i]);
+    ++i;
+  };
+  while (i < keys_.size() || j < reps.size()) {
+    if (j == reps.size() || (i < keys_.size() && keys_[i] < reps[j].first)) {
+      take_old();
+    } else if (i == keys_.size() || reps[j].first < keys_[i]) {
+      take_new();
+    } else {
+      take_old();  // the voxel is known: its first point stays
+      ++j;
+    }
+  }
+  keys_ = std::move(keys);
+  cloud_ = std::move(merged);
 }
 
 }  // namespace scanplan

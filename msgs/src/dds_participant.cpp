@@ -66,6 +66,9 @@ std::unique_ptr<dds_qos_t, QosDeleter> make_qos(QosKind kind) {
     case QosKind::kScanData:
       // Four scans is minutes of robot time; a reader that far behind has bigger problems.
       dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, 4);
+      // Only bridges write scan data: the server must see one vanish mid-scan.
+      dds_qset_liveliness(q.get(), DDS_LIVELINESS_AUTOMATIC,
+                          DDS_MSECS(kBridgeLivelinessLease.count()));
       break;
     case QosKind::kCommand:
       dds_qset_history(q.get(), DDS_HISTORY_KEEP_ALL, 0);
@@ -73,6 +76,14 @@ std::unique_ptr<dds_qos_t, QosDeleter> make_qos(QosKind kind) {
       break;
     case QosKind::kStatus:
       dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, 1);
+      // The status writer is how the server knows which robot a bridge speaks for, and its
+      // lease is how it knows the bridge is still there.
+      dds_qset_liveliness(q.get(), DDS_LIVELINESS_AUTOMATIC,
+                          DDS_MSECS(kBridgeLivelinessLease.count()));
+      break;
+    case QosKind::kLatched:
+      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, 1);
+      dds_qset_durability(q.get(), DDS_DURABILITY_TRANSIENT_LOCAL);
       break;
   }
   return q;
@@ -88,9 +99,9 @@ dds_entity_t Participant::writer(const dds_topic_descriptor_t& type, const std::
 }
 
 dds_entity_t Participant::reader(const dds_topic_descriptor_t& type, const std::string& name,
-                                 QosKind qos) {
+                                 QosKind qos, const dds_listener_t* listener) {
   const dds_entity_t r =
-      dds_create_reader(participant_, topic(type, name), make_qos(qos).get(), nullptr);
+      dds_create_reader(participant_, topic(type, name), make_qos(qos).get(), listener);
   return check(r, "creating a reader for " + name);
 }
 

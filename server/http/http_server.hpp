@@ -24,12 +24,12 @@ struct ServerConfig {
   std::string host = "127.0.0.1";  // numeric address or name; "::" or "0.0.0.0" for all
   std::uint16_t port = 8080;       // 0 picks an ephemeral port; see HttpServer::port()
   Limits limits;
+  // Receives operational problems (handler exceptions, accept failures). Empty means stderr.
+  std::function<void(std::string_view)> log;
   // Lets several servers, each with its own loop thread, listen on one port (SO_REUSEPORT): the
   // kernel spreads new connections over them, so the API uses more than one core. Start one
   // with the wanted port (0 for an ephemeral one), then the others on the port it got.
   bool reuse_port = false;
-  // Receives operational problems (handler exceptions, accept failures). Empty means stderr.
-  std::function<void(std::string_view)> log;
 };
 
 // HTTP/1.1 server: one thread runs a level-triggered epoll loop over non-blocking sockets.

@@ -114,12 +114,13 @@ std::string iso_time(std::chrono::system_clock::time_point t) {
 
 }  // namespace
 
-Api::Api(ScanStore& store, ScanIntake& intake, DdsLink& dds, Mission& mission, const Auth& auth,
-         std::string session_dir)
+Api::Api(ScanStore& store, ScanIntake& intake, DdsLink& dds, Mission& mission,
+         Annotations& annotations, const Auth& auth, std::string session_dir)
     : store_(store),
       intake_(intake),
       dds_(dds),
       mission_(mission),
+      annotations_(annotations),
       auth_(auth),
       session_dir_(std::move(session_dir)),
       started_(std::chrono::system_clock::now()) {}
@@ -181,6 +182,18 @@ void Api::install(http::Router& router) {
     require(r, Role::kOperator);
     return request_scan(r);
   });
+  router.add("GET", "/api/v1/annotations", [this](const Request& r, const auto&) {
+    require(r, Role::kViewer);
+    return list_annotations();
+  });
+  router.add("POST", "/api/v1/annotations", [this](const Request& r, const auto&) {
+    require(r, Role::kOperator);
+    return post_annotation(r);
+  });
+  router.add("DELETE", "/api/v1/annotations/{id}", [this](const Request& r, const auto& params) {
+    require(r, Role::kOperator);
+    return delete_annotation(r, params.at("id"));
+  });
 }
 
 void Api::require(const Request& request, Role needed) const {
@@ -203,7 +216,11 @@ Response Api::session(const Request& request) const {
   const std::optional<StoredScan> last = store_.last_scan();
   json robots = json::object();
   for (const auto& [id, r] : store_.robot_states()) {
-    robots[id] = {{"state", r.status.state},
+    const bool connected = r.connection.connected;
+    robots[id] = {{"connected", connected},
+                  {"lost_at", connected ? json(nullptr) : json(r.connection.lost_at)},
+                  {"lost_reason", connected ? json(nullptr) : json(r.connection.reason)},
+                  {"state", r.status.state},
                   {"command_id", r.status.command_id},
                   {"message", r.status.message},
                   {"pose", pose_json(r.status.reported)},
@@ -394,7 +411,7 @@ Response Api::decide(const Request& request, const std::string& id, const std::s
     json body;
     try {
       body = json::parse(request.body);
-    } catch (const json::parse_error&) {
+    } catch (const json::exception&) {
       throw HttpError(400, "bad_request",
                       "the body, when given, must be JSON like {\"by\": \"name\"}");
     }
@@ -492,7 +509,7 @@ Response Api::put_params(const Request& request) {
   json body;
   try {
     body = json::parse(request.body);
-  } catch (const json::parse_error&) {
+  } catch (const json::exception&) {
     throw HttpError(400, "bad_request", "the body must be a JSON object of parameters");
   }
   if (!body.is_object()) throw HttpError(400, "bad_request", "the body must be a JSON object");
@@ -541,6 +558,130 @@ Response Api::put_params(const Request& request) {
   }
   store_.set_params(p);
   return Response::json(200, params_json(store_.params()));
+}
+
+namespace {
+
+// Annotations are bounded to where a map could be: a coordinate beyond this is a unit mistake
+// (millimetres, a GPS longitude in the wrong field), not a place.
+constexpr double kMaxCoordinateM = 1e6;
+
+const char* const kAnnotationShape =
+    "an annotation is {\"kind\": \"victim|hazard|blocked|note\", \"x\": m, \"y\": m, "
+    "\"z\": m, \"text\": \"...\"} with optional \"by\": \"your name\"";
+
+// The request body as a JSON object; 400 naming what is wrong otherwise.
+json object_body(const Request& request, const char* shape) {
+  json body;
+  try {
+    body = json::parse(request.body);
+  } catch (const json::exception& e) {  // parse_error, or out_of_range for a literal like 1e999
+    throw HttpError(400, "bad_request",
+                    std::string("the body is not valid JSON (") + e.what() + "); " + shape);
+  }
+  if (!body.is_object()) {
+    throw HttpError(400, "bad_request", std::string("the body must be a JSON object: ") + shape);
+  }
+  return body;
+}
+
+double coordinate(const json& body, const char* key) {
+  if (!body.contains(key)) {
+    throw HttpError(400, "bad_request",
+                    std::string("'") + key + "' is required (metres in the map frame)");
+  }
+  const json& v = body.at(key);
+  // JSON has no NaN; an overflowing literal like 1e999 parses as infinity.
+  if (!v.is_number() || !std::isfinite(v.get<double>()) ||
+      std::abs(v.get<double>()) > kMaxCoordinateM) {
+    throw HttpError(400, "bad_request",
+                    std::string("'") + key +
+                        "' must be a finite number of metres in the map frame, within ±" +
+                        std::to_string(static_cast<long>(kMaxCoordinateM)) + ", got " + v.dump());
+  }
+  return v.get<double>();
+}
+
+// Who acts, recorded as decisions are: the role, and the name the operator gave, if any.
+std::string author_of(const json& body) {
+  if (!body.contains("by")) return "operator";
+  const json& by = body.at("by");
+  if (!by.is_string() || by.get<std::string>().empty() || by.get<std::string>().size() > 64) {
+    throw HttpError(400, "bad_request", "'by' must be a name of 1 to 64 bytes");
+  }
+  return "operator " + by.get<std::string>();
+}
+
+}  // namespace
+
+Response Api::list_annotations() const {
+  json list = json::array();
+  for (const Annotation& a : annotations_.list()) list.push_back(annotation_json(a));
+  return Response::json(200, {{"annotations", list}});
+}
+
+Response Api::post_annotation(const Request& request) {
+  const json body = object_body(request, kAnnotationShape);
+  for (const auto& [key, value] : body.items()) {
+    if (key != "kind" && key != "x" && key != "y" && key != "z" && key != "text" && key != "by") {
+      throw HttpError(400, "bad_request", "unknown field '" + key + "': " + kAnnotationShape);
+    }
+  }
+  if (!body.contains("kind") || !body["kind"].is_string() ||
+      std::find(kAnnotationKinds.begin(), kAnnotationKinds.end(),
+                body["kind"].get<std::string>()) == kAnnotationKinds.end()) {
+    throw HttpError(400, "bad_request",
+                    "'kind' must be \"victim\", \"hazard\", \"blocked\" or \"note\", got " +
+                        (body.contains("kind") ? body["kind"].dump() : std::string("nothing")));
+  }
+  const std::string kind = body["kind"].get<std::string>();
+  const double x = coordinate(body, "x"), y = coordinate(body, "y"), z = coordinate(body, "z");
+  std::string text;
+  if (body.contains("text")) {
+    if (!body["text"].is_string()) throw HttpError(400, "bad_request", "'text' must be a string");
+    text = body["text"].get<std::string>();
+  }
+  if (text.size() > kMaxAnnotationTextBytes) {
+    throw HttpError(400, "bad_request",
+                    "'text' is too long: " + std::to_string(text.size()) + " bytes, at most " +
+                        std::to_string(kMaxAnnotationTextBytes));
+  }
+  if (kind == "note" && text.empty()) {
+    throw HttpError(400, "bad_request", "'text' is required for a note");
+  }
+  const std::string author = author_of(body);
+  try {
+    return Response::json(201, annotation_json(annotations_.add(kind, x, y, z, text, author)));
+  } catch (const SessionStoreError& e) {
+    throw HttpError(503, "storage_failed",
+                    std::string("the annotation could not be stored: ") + e.what());
+  }
+}
+
+Response Api::delete_annotation(const Request& request, const std::string& id) {
+  std::int64_t n = 0;
+  const auto [end, ec] = std::from_chars(id.data(), id.data() + id.size(), n);
+  if (ec != std::errc() || end != id.data() + id.size() || n <= 0) {
+    throw HttpError(400, "bad_request",
+                    "an annotation id is a positive whole number, got '" + id + "'");
+  }
+  std::string by = "operator";
+  if (!request.body.empty()) {
+    const json body = object_body(request, "the body, when given, is {\"by\": \"your name\"}");
+    for (const auto& [key, value] : body.items()) {
+      if (key != "by") throw HttpError(400, "bad_request", "unknown field '" + key + "'");
+    }
+    by = author_of(body);
+  }
+  try {
+    if (!annotations_.remove(n, by)) {
+      throw HttpError(404, "not_found", "no annotation " + id + " in this session");
+    }
+  } catch (const SessionStoreError& e) {
+    throw HttpError(503, "storage_failed",
+                    std::string("the deletion could not be stored: ") + e.what());
+  }
+  return Response::json(200, {{"id", n}, {"deleted", true}, {"by", by}});
 }
 
 Response Api::request_scan(const Request& request) {

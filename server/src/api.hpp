@@ -3,6 +3,7 @@
 #include <chrono>
 #include <string>
 
+#include "annotations.hpp"
 #include "auth.hpp"
 #include "dds_link.hpp"
 #include "http/router.hpp"
@@ -15,8 +16,8 @@ namespace scanplan::server {
 // link and back; they hold no state of their own beyond the session's start time.
 class Api {
  public:
-  Api(ScanStore& store, ScanIntake& intake, DdsLink& dds, Mission& mission, const Auth& auth,
-      std::string session_dir);
+  Api(ScanStore& store, ScanIntake& intake, DdsLink& dds, Mission& mission,
+      Annotations& annotations, const Auth& auth, std::string session_dir);
   void install(http::Router& router);
 
  private:
@@ -38,11 +39,15 @@ class Api {
   http::Response decisions(const http::Request& request) const;
   http::Response decide(const http::Request& request, const std::string& id,
                         const std::string& action);
+  http::Response list_annotations() const;
+  http::Response post_annotation(const http::Request& request);
+  http::Response delete_annotation(const http::Request& request, const std::string& id);
 
   ScanStore& store_;
   ScanIntake& intake_;
   DdsLink& dds_;
   Mission& mission_;
+  Annotations& annotations_;
   const Auth& auth_;
   std::string session_dir_;
   std::chrono::system_clock::time_point started_;

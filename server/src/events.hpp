@@ -17,8 +17,9 @@ class Events {
  public:
   explicit Events(http::WebSocketHub* hub = nullptr) : hub_(hub) {}
 
-  // Event types: scan_progress, robot_status, scan_received, map_updated, plan_done,
-  // decision, move_state.
+  // Event types (docs/api.md): scan_progress, robot_status, scan_received, map_updated,
+  // match_done, plan_done, mission, annotation, annotation_deleted, robot_lost, robot_back,
+  // scan_failed; the hub adds binary_dropped.
   void publish(const std::string& type, nlohmann::json data) const;
   // The new points of scan `scan_id` in the map frame, Draco-encoded: binary frame op 1.
   void map_chunk(std::int64_t scan_id, const std::string& draco) const;

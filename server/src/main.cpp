@@ -13,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "annotations.hpp"
 #include "api.hpp"
 #include "auth.hpp"
 #include "dds_link.hpp"
@@ -94,7 +95,15 @@ int main(int argc, char** argv) {
     dds.on_status = [&mission](const std::string& robot, const srv::RobotStatus& status) {
       mission.on_status(robot, status);
     };
-    srv::Api api(store, intake, dds, mission, auth, session_dir);
+    srv::Annotations annotations(session, dds, events);
+    // Wired before the intake starts: the scans it reloads after a restart republish the map
+    // and the plan for DDS subscribers.
+    store.on_map = [&dds](const scanplan::PointCloud& map) { dds.publish_map(map); };
+    store.on_plan = [&dds](const srv::PlanRecord& plan) { dds.publish_candidates(plan); };
+    annotations.republish();
+    dds.on_robot_lost = [&mission](const srv::RobotLoss& loss) { mission.on_robot_lost(loss); };
+    dds.on_robot_back = [&mission](const std::string& robot) { mission.on_robot_back(robot); };
+    srv::Api api(store, intake, dds, mission, annotations, auth, session_dir);
     http::Router router([](std::string_view msg) { spdlog::error("{}", msg); });
     api.install(router);
     // Browsers cannot set headers on a WebSocket: the token may come as ?token=.

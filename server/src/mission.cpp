@@ -21,6 +21,15 @@ void Mission::record(const std::string& kind, json details) {
   }
 }
 
+void Mission::record_event(const std::string& type, const json& details) {
+  events_.publish(type, details);
+  try {
+    session_.append_event(type, details.dump());
+  } catch (const std::exception& e) {
+    spdlog::error("could not record '{}' in the session: {}", type, e.what());
+  }
+}
+
 CandidateRecord Mission::find(std::uint64_t id, std::string* robot) const {
   const auto plan = store_.plan();
   if (plan) {
@@ -41,20 +50,15 @@ json Mission::approve(std::uint64_t id, const std::string& by) {
   std::lock_guard lock(mutex_);
   std::string robot;
   const CandidateRecord c = find(id, &robot);
-  if (c.state != "proposed") {
+  // An interrupted move (its bridge was lost) may be approved again once the robot is back.
+  if (c.state != "proposed" && c.state != "interrupted") {
     throw MissionError(409, "conflict", "candidate " + std::to_string(id) + " is " + c.state);
   }
   if (moving_.count(robot)) {
     throw MissionError(409, "conflict",
                        "robot '" + robot + "' is still carrying out an approved move");
   }
-  // Face along the last leg of the path, so the scan starts looking where the robot went.
-  double yaw_deg = 0;
-  const auto& path = c.candidate.path;
-  if (path.size() >= 2) {
-    const Eigen::Vector2d d = path.back() - path[path.size() - 2];
-    yaw_deg = rad2deg(std::atan2(d.y(), d.x()));
-  }
+  const double yaw_deg = approach_yaw_deg(c.candidate);
   std::uint32_t command = 0;
   try {
     command = dds_.request_move(robot, c.candidate.position.x(), c.candidate.position.y(), yaw_deg);
@@ -63,6 +67,12 @@ json Mission::approve(std::uint64_t id, const std::string& by) {
   }
   moving_[robot] = {command, id};
   store_.set_candidate_state(id, "moving");
+  Pose goal;
+  goal.x = c.candidate.position.x();
+  goal.y = c.candidate.position.y();
+  goal.z = c.candidate.position.z();
+  goal.yaw = deg2rad(yaw_deg);
+  dds_.publish_goal(goal);
   const json out = {{"candidate", id},
                     {"robot", robot},
                     {"command_id", command},
@@ -77,7 +87,7 @@ json Mission::approve(std::uint64_t id, const std::string& by) {
 json Mission::reject(std::uint64_t id, const std::string& by, const std::string& reason) {
   std::lock_guard lock(mutex_);
   const CandidateRecord c = find(id, nullptr);
-  if (c.state != "proposed") {
+  if (c.state != "proposed" && c.state != "interrupted") {
     throw MissionError(409, "conflict", "candidate " + std::to_string(id) + " is " + c.state);
   }
   store_.set_candidate_state(id, "rejected", reason);
@@ -106,6 +116,8 @@ json Mission::cancel(std::uint64_t id, const std::string& by) {
   }
   moving_.erase(it);
   store_.set_candidate_state(id, "cancelled");
+  // The robot's goal is now where it stands; the old one must not linger on the latched topic.
+  if (rs != states.end()) dds_.publish_goal(here);
   const json out = {{"candidate", id}, {"robot", robot}, {"by", by}};
   record("cancel", out);
   return out;
@@ -170,6 +182,37 @@ void Mission::on_status(const std::string& robot, const RobotStatus& status) {
     store_.set_candidate_state(candidate, "refused", status.message);
     record("refused", {{"candidate", candidate}, {"robot", robot}, {"message", status.message}});
   }
+}
+
+void Mission::on_robot_lost(const RobotLoss& loss) {
+  std::lock_guard lock(mutex_);
+  record_event("robot_lost",
+               {{"robot", loss.robot}, {"reason", loss.reason}, {"lost_at", loss.lost_at}});
+  if (loss.scan) {
+    record_event("scan_failed", {{"robot", loss.robot},
+                                 {"command_id", loss.scan->command_id},
+                                 {"fraction", loss.scan->fraction},
+                                 {"parts_discarded", loss.scan->parts_discarded},
+                                 {"reason", DdsLink::kScanLostReason}});
+  }
+  const auto it = moving_.find(loss.robot);
+  if (it == moving_.end()) return;
+  // Where the robot stopped is unknown until its bridge reports again; the operator decides
+  // anew (the candidate may be approved again once the robot is back).
+  const std::uint64_t candidate = it->second.candidate;
+  const std::uint32_t command = it->second.command_id;
+  moving_.erase(it);
+  const std::string note = "the move was interrupted: " + loss.reason;
+  store_.set_candidate_state(candidate, "interrupted", note);
+  record("interrupted", {{"candidate", candidate},
+                         {"robot", loss.robot},
+                         {"command_id", command},
+                         {"message", note}});
+}
+
+void Mission::on_robot_back(const std::string& robot) {
+  std::lock_guard lock(mutex_);
+  record_event("robot_back", {{"robot", robot}});
 }
 
 }  // namespace scanplan::server

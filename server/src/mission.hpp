@@ -42,6 +42,10 @@ class Mission {
   nlohmann::json log(std::size_t limit) const;
   // From the DDS thread.
   void on_status(const std::string& robot, const RobotStatus& status);
+  // The robot's bridge is gone: tells the operator, records it, reports the scan it cost and
+  // frees an approved move so the operator can decide again.
+  void on_robot_lost(const RobotLoss& loss);
+  void on_robot_back(const std::string& robot);
 
  private:
   struct ActiveMove {
@@ -49,7 +53,10 @@ class Mission {
     std::uint64_t candidate;
   };
   CandidateRecord find(std::uint64_t candidate, std::string* robot) const;
+  // Publishes a "mission" event {kind, ...} and records it in the session.
   void record(const std::string& kind, nlohmann::json details);
+  // Publishes an event of its own type and records it in the session under that name.
+  void record_event(const std::string& type, const nlohmann::json& details);
 
   ScanStore& store_;
   DdsLink& dds_;

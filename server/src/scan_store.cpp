@@ -1,6 +1,7 @@
 #include "scan_store.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "scanplan/core/draco_codec.hpp"
@@ -9,8 +10,56 @@
 
 namespace scanplan::server {
 
+double approach_yaw_deg(const Candidate& c) {
+  const auto& path = c.path;
+  if (path.size() < 2) return 0;
+  const Eigen::Vector2d d = path.back() - path[path.size() - 2];
+  return rad2deg(std::atan2(d.y(), d.x()));
+}
+
 ScanStore::ScanStore(PipelineConfig pipeline, PlannerConfig planner)
-    : pipeline_(pipeline), planner_(planner) {}
+    : pipeline_(pipeline), planner_(planner), encoder_([this] { encode_loop(); }) {}
+
+ScanStore::~ScanStore() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  encode_wanted_.notify_all();
+  encoder_.join();
+}
+
+void ScanStore::encode_loop() {
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    encode_wanted_.wait(lock, [&] {
+      return stopping_ || (!scans_.empty() && encoded_last_scan_ != scans_.back().id);
+    });
+    if (stopping_) return;
+    const auto parts = placed_;
+    const std::int64_t last = scans_.back().id;
+    const std::size_t count = point_count_;
+    lock.unlock();
+    std::shared_ptr<const std::string> encoded;
+    try {
+      PointCloud all;
+      all.reserve(count);
+      for (const auto& p : parts) all.append(*p);
+      if (!all.empty()) encoded = std::make_shared<const std::string>(encode_draco(all));
+    } catch (const std::exception&) {
+      // Out of memory or a Draco failure: the previous encoding stays; readers see its
+      // last_scan and can fetch the rest with ?since.
+      lock.lock();
+      encoded_last_scan_ = last;
+      encoded_changed_.notify_all();
+      continue;
+    }
+    lock.lock();
+    encoded_ = std::move(encoded);
+    encoded_last_scan_ = last;
+    encoded_changed_.notify_all();
+  }
+}
 
 const std::vector<std::string>& ScanStore::layer_names() {
   static const std::vector<std::string> kNames = {"regions", "elevation", "movable"};
@@ -28,39 +77,38 @@ void ScanStore::add(const StoredScan& scan, const PointCloud& cloud) {
   }
 
   // Writers take turns on encode_mutex_; readers only wait for the short commit below, and
-  // they see the scan, its points and the map encoding that includes it appear together.
+  // they see the scan, its points, its chunk and the plan that includes it appear together.
   const Bounds3 added = bounds_of(placed);
   std::lock_guard encode_lock(encode_mutex_);
-  PointCloud next;
-  {
-    std::lock_guard lock(mutex_);
-    next = map_;
-  }
-  next.append(placed);
-  std::shared_ptr<const std::string> encoded, chunk;
-  if (!next.empty()) encoded = std::make_shared<const std::string>(encode_draco(next));
+  std::shared_ptr<const std::string> chunk;
   if (!placed.empty()) chunk = std::make_shared<const std::string>(encode_draco(placed));
+  auto shared = std::make_shared<const PointCloud>(std::move(placed));
 
+  thinned_.add(*shared);
   pipeline_.add_scan(cloud, pose);
   last_scan_ = {scan.id, scan.robot};
-  refresh_derived([&] {
+  const auto plan = refresh_derived([&] {
     scans_.push_back(scan);
-    offsets_.push_back(map_.size());
     chunks_[scan.id] = chunk;
-    map_ = std::move(next);
+    point_count_ += shared->size();
+    placed_.push_back(std::move(shared));
     if (added.valid()) {
       bounds_.extend(added.min);
       bounds_.extend(added.max);
     }
-    encoded_ = std::move(encoded);
   });
+  encode_wanted_.notify_one();
+  // Outside mutex_ so readers are not held up, inside encode_mutex_ so maps and plans go out in
+  // the order they were made; the map first, as the plan is made from it.
+  if (on_map) on_map(thinned_.cloud());
+  if (plan && on_plan) on_plan(*plan);
 }
 
-void ScanStore::refresh_derived(const std::function<void()>& commit) {
+std::optional<PlanRecord> ScanStore::refresh_derived(const std::function<void()>& commit) {
   if (!pipeline_.regions() || !pipeline_.movable()) {
     std::lock_guard lock(mutex_);
     if (commit) commit();
-    return;
+    return std::nullopt;
   }
   const RegionMap& regions = *pipeline_.regions();
   const MovableRegion& movable = *pipeline_.movable();
@@ -110,20 +158,23 @@ void ScanStore::refresh_derived(const std::function<void()>& commit) {
     geometry.height = g.rows * s;
   }
 
-  // The scan, its map and everything derived from it appear to readers together.
-  std::lock_guard lock(mutex_);
-  if (commit) commit();
-  if (plan_) {
-    for (auto& c : plan_->candidates) {
-      if (c.state == "proposed") c.state = "superseded";
+  {
+    // The scan, its map and everything derived from it appear to readers together.
+    std::lock_guard lock(mutex_);
+    if (commit) commit();
+    if (plan_) {
+      for (auto& c : plan_->candidates) {
+        if (c.state == "proposed") c.state = "superseded";
+      }
     }
+    plan_ = record;
+    layers_ = std::move(layers);
+    layer_geometry_ = geometry;
+    areas_ = areas;
+    // A commit means a scan joined (set_params re-segments without one).
+    if (commit) areas_after_[last_scan_.first] = areas;
   }
-  plan_ = std::move(record);
-  layers_ = std::move(layers);
-  layer_geometry_ = geometry;
-  areas_ = areas;
-  // A commit means a scan joined (set_params re-segments without one).
-  if (commit) areas_after_[last_scan_.first] = areas;
+  return record;
 }
 
 std::optional<PlanRecord> ScanStore::plan() const {
@@ -214,7 +265,8 @@ void ScanStore::set_params(const MissionParams& params) {
   planner_ = params.planner;
   pipeline_.set_region_configs(params.planner.regions, params.planner.movable);
   if (params.target) pipeline_.set_target(*params.target);
-  refresh_derived({});
+  const auto plan = refresh_derived({});
+  if (plan && on_plan) on_plan(*plan);
 }
 
 PointCloud ScanStore::points_near(double x, double y, double radius_m) const {
@@ -222,8 +274,10 @@ PointCloud ScanStore::points_near(double x, double y, double radius_m) const {
   PointCloud out;
   const Eigen::Vector2f c(static_cast<float>(x), static_cast<float>(y));
   const float r2 = static_cast<float>(radius_m * radius_m);
-  for (const auto& p : map_.points) {
-    if ((p.head<2>() - c).squaredNorm() <= r2) out.points.push_back(p);
+  for (const auto& part : placed_) {
+    for (const auto& p : part->points) {
+      if ((p.head<2>() - c).squaredNorm() <= r2) out.points.push_back(p);
+    }
   }
   return out;
 }
@@ -246,7 +300,7 @@ std::size_t ScanStore::scan_count() const {
 
 std::size_t ScanStore::point_count() const {
   std::lock_guard lock(mutex_);
-  return map_.size();
+  return point_count_;
 }
 
 Bounds3 ScanStore::bounds() const {
@@ -254,9 +308,12 @@ Bounds3 ScanStore::bounds() const {
   return bounds_;
 }
 
-ScanStore::EncodedMap ScanStore::encoded_map() const {
-  std::lock_guard lock(mutex_);
-  return {encoded_, scans_.empty() ? 0 : scans_.back().id};
+ScanStore::EncodedMap ScanStore::encoded_map(std::chrono::milliseconds wait) const {
+  std::unique_lock lock(mutex_);
+  if (scans_.empty()) return {};
+  encoded_changed_.wait_for(lock, wait,
+                            [&] { return stopping_ || encoded_last_scan_ == scans_.back().id; });
+  return {encoded_, encoded_last_scan_};
 }
 
 std::shared_ptr<const std::string> ScanStore::encoded_chunk(std::int64_t id) const {
@@ -268,6 +325,7 @@ std::shared_ptr<const std::string> ScanStore::encoded_chunk(std::int64_t id) con
 ScanStore::EncodedMap ScanStore::encoded_since(std::int64_t since_id) const {
   PointCloud tail;
   std::int64_t last = 0;
+  bool whole = false;
   {
     std::lock_guard lock(mutex_);
     if (scans_.empty()) return {};
@@ -280,12 +338,14 @@ ScanStore::EncodedMap ScanStore::encoded_since(std::int64_t since_id) const {
       }
     }
     if (first == scans_.size()) return {nullptr, last};
+    whole = first == 0;
     // The common case, one scan behind, is already encoded.
     if (first + 1 == scans_.size()) return {chunks_.at(scans_[first].id), last};
-    const std::size_t from = offsets_[first];
-    tail.points.assign(map_.points.begin() + from, map_.points.end());
-    tail.colors.assign(map_.colors.begin() + from, map_.colors.end());
+    if (!whole) {
+      for (std::size_t i = first; i < placed_.size(); ++i) tail.append(*placed_[i]);
+    }
   }
+  if (whole) return encoded_map();
   if (tail.empty()) return {nullptr, last};
   return {std::make_shared<const std::string>(encode_draco(tail)), last};
 }
@@ -306,10 +366,7 @@ ScanStore::EncodedMap ScanStore::encoded_range(std::int64_t since_id, std::int64
     }
     if (first >= end) return {nullptr, last};
     if (first + 1 == end) return {chunks_.at(scans_[first].id), last};
-    const std::size_t from = offsets_[first];
-    const std::size_t to = end < scans_.size() ? offsets_[end] : map_.size();
-    part.points.assign(map_.points.begin() + from, map_.points.begin() + to);
-    part.colors.assign(map_.colors.begin() + from, map_.colors.begin() + to);
+    for (std::size_t i = first; i < end; ++i) part.append(*placed_[i]);
   }
   if (part.empty()) return {nullptr, last};
   return {std::make_shared<const std::string>(encode_draco(part)), last};
@@ -354,6 +411,11 @@ void ScanStore::set_scan_state(const std::string& robot_id, RobotScanState state
 void ScanStore::set_robot_status(const std::string& robot_id, RobotStatus status) {
   std::lock_guard lock(mutex_);
   robots_[robot_id].status = std::move(status);
+}
+
+void ScanStore::set_robot_connection(const std::string& robot_id, RobotConnection connection) {
+  std::lock_guard lock(mutex_);
+  robots_[robot_id].connection = std::move(connection);
 }
 
 std::map<std::string, RobotState> ScanStore::robot_states() const {

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -8,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "scanplan/core/mapping_pipeline.hpp"
@@ -15,6 +18,7 @@
 #include "scanplan/core/pose.hpp"
 #include "scanplan/core/scan_planner.hpp"
 #include "scanplan/core/session_store.hpp"
+#include "scanplan/core/voxel_filter.hpp"
 
 namespace scanplan::server {
 
@@ -34,9 +38,17 @@ struct RobotStatus {
   Pose reported;
 };
 
+// Whether the robot's bridge is alive on DDS (its liveliness lease, docs/dds.md).
+struct RobotConnection {
+  bool connected = true;
+  std::string lost_at;  // UTC, ISO 8601; empty while connected
+  std::string reason;   // why it was lost; empty while connected
+};
+
 struct RobotState {
   RobotStatus status;
   RobotScanState scan;
+  RobotConnection connection;
 };
 
 // Areas of the target region's C / M / U segmentation and of the movable region (m²).
@@ -86,6 +98,9 @@ class GoalRefused : public std::runtime_error {
       : std::runtime_error(message), code(std::move(code)) {}
   std::string code;
 };
+// The heading a robot takes at candidate `c`: along the last leg of its path, so the scan starts
+// looking where the robot went (0 without a path). Degrees, map frame.
+double approach_yaw_deg(const Candidate& c);
 
 // What the operator can change while the mission runs (PUT /api/v1/params).
 struct MissionParams {
@@ -93,12 +108,29 @@ struct MissionParams {
   std::optional<TargetRegion> target;  // nothing: the pipeline's default square
 };
 
-// The scans of this session, in the map frame, with what is derived from them: the map's Draco
-// encoding, the MLS map with its regions, and the top-view layers as PNG. All of it is rebuilt
-// off the network thread each time a scan lands, so serving never waits on an encoder.
+// The scans of this session, in the map frame, with what is derived from them: each scan's
+// Draco chunk, the MLS map with its regions, the top-view layers as PNG and the plan, rebuilt
+// off the network thread each time a scan lands and published together. The whole map's Draco
+// encoding grows with the session (seconds for millions of points), so it is made on a thread
+// of its own after the scan is published: new candidates never wait for it.
 class ScanStore {
  public:
   explicit ScanStore(PipelineConfig pipeline = {}, PlannerConfig planner = {});
+  ~ScanStore();
+  ScanStore(const ScanStore&) = delete;
+  ScanStore& operator=(const ScanStore&) = delete;
+
+  // Side of the cubes the map is thinned to for subscribers who take the whole map at once
+  // (DDS rt/scanplan/map): 0.3 m keeps walls, doorways and cars recognisable, and the yard
+  // after a scan, or a campus block, stays within a few MB a message.
+  static constexpr double kThinnedMapVoxelM = 0.3;
+
+  // Told of each new thinned map (map frame, coloured, kThinnedMapVoxelM) and each new plan, in
+  // the order they were made, on the thread that made them (the intake worker, or the one
+  // changing parameters). Set them before the first add(). They run while the store's writers
+  // wait, so they must be quick and must not call add() or the params functions.
+  std::function<void(const PointCloud& thinned_map)> on_map;
+  std::function<void(const PlanRecord& plan)> on_plan;
 
   // A stored scan joins the map: `cloud` is in the scan's own frame, `scan.placed` puts it in
   // the map frame. Scans must come in id order.
@@ -115,7 +147,9 @@ class ScanStore {
     std::shared_ptr<const std::string> draco;  // null when there are no points
     std::int64_t last_scan = 0;                // the newest scan included
   };
-  EncodedMap encoded_map() const;
+  // The whole map's encoding. When the encoder is still behind the newest scan, waits for it
+  // up to `wait`; after that, the newest encoding there is (`last_scan` says which).
+  EncodedMap encoded_map(std::chrono::milliseconds wait = std::chrono::seconds(15)) const;
   // The points of the scans after `since_id` only: what a browser that already holds the map
   // up to that scan needs.
   EncodedMap encoded_since(std::int64_t since_id) const;
@@ -149,15 +183,23 @@ class ScanStore {
 
   void set_scan_state(const std::string& robot_id, RobotScanState state);
   void set_robot_status(const std::string& robot_id, RobotStatus status);
+  void set_robot_connection(const std::string& robot_id, RobotConnection connection);
   std::map<std::string, RobotState> robot_states() const;
 
  private:
   mutable std::mutex mutex_;
   std::vector<StoredScan> scans_;
-  PointCloud map_;
-  Bounds3 bounds_;  // of map_, kept as scans arrive: the session endpoint is polled often
-  std::shared_ptr<const std::string> encoded_;
-  std::vector<std::size_t> offsets_;  // where each scan's points start in map_
+  // Each scan's points in the map frame, in the order of scans_: shared with the encoder
+  // thread, never copied whole.
+  std::vector<std::shared_ptr<const PointCloud>> placed_;
+  std::size_t point_count_ = 0;
+  Bounds3 bounds_;  // of all points, kept as scans arrive: the session endpoint is polled often
+  std::shared_ptr<const std::string> encoded_;  // the whole map up to encoded_last_scan_
+  std::int64_t encoded_last_scan_ = 0;
+  mutable std::condition_variable encoded_changed_;  // with mutex_
+  std::condition_variable encode_wanted_;            // with mutex_
+  bool stopping_ = false;
+  VoxelMap thinned_{kThinnedMapVoxelM};  // under encode_mutex_
   std::map<std::int64_t, std::shared_ptr<const std::string>> chunks_;
   std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> layers_;
   MapAreas areas_;
@@ -170,10 +212,16 @@ class ScanStore {
   std::optional<PlanRecord> plan_;
   std::map<std::string, RobotState> robots_;
   mutable std::mutex encode_mutex_;  // one writer at a time; readers keep the previous result
+  std::thread encoder_;              // last member: starts once everything else exists
+
+  // The encoder thread: encodes the whole map whenever a scan has joined since the last time
+  // (several scans that arrived meanwhile in one go).
+  void encode_loop();
 
   // Recomputes layers, areas and the plan from the pipeline and publishes them together with
-  // whatever `commit` changes (run under mutex_); needs encode_mutex_ held.
-  void refresh_derived(const std::function<void()>& commit);
+  // whatever `commit` changes (run under mutex_); needs encode_mutex_ held. Returns the new plan
+  // (nothing when there is no map to plan on yet).
+  std::optional<PlanRecord> refresh_derived(const std::function<void()>& commit);
 };
 
 }  // namespace scanplan::server

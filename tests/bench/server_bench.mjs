@@ -4,7 +4,8 @@
 // it), and for each the time from the upload to the new candidates on the events WebSocket
 // (plan_done) is measured, with the server's resident memory after each. Beside it, from the
 // same run's events, the two computations inside that latency (matching and planning), so the
-// rest (storing, inserting, encoding, the network) shows too. Prints one JSON line. Run with
+// rest (storing, inserting, encoding, the network) shows too. Between scans the bench waits
+// for the whole map's new encoding (GET map.drc), as a robot's one-minute scan would. Prints one JSON line. Run with
 // tests/bench/server_bench.sh.
 import { execFileSync } from 'node:child_process';
 import { readFileSync, mkdtempSync, rmSync } from 'node:fs';
@@ -69,9 +70,16 @@ try {
     const { e: plan, at } = await planned;
     // The first scan has nothing to be matched against.
     const match = k > 0 ? (await matched).e : null;
+    // A real scan takes a minute: by the next one the server has long re-encoded the whole
+    // map. Wait for that here too, so that each scan meets the idle server a robot would find.
+    const whole = await stack.api('GET', '/api/v1/map.drc');
+    await whole.arrayBuffer();
+    const wholeAt = performance.now();
+    if (whole.headers.get('x-scanplan-last-scan') !== String(k + 1)) throw new Error('map.drc lags');
     rows.push({ scan: k + 1, points: info.points, ply_mb: body.length / 1e6, ms_to_stored: stored - t0,
       ms_to_candidates: at - t0, ms_match: match?.time_ms ?? 0, match_applied: match?.applied ?? null,
-      ms_plan: plan.plan_ms, candidates: plan.candidates, ...rssKb(stack.server.pid) });
+      ms_plan: plan.plan_ms, candidates: plan.candidates, match_message: match?.message ?? null,
+      ms_to_whole_map: wholeAt - t0, ...rssKb(stack.server.pid) });
     process.stderr.write(`scan ${k + 1}: ${info.points} points, candidates after ${(at - t0).toFixed(0)} ms, ` +
       `rss ${(rssKb(stack.server.pid).rss / 1024).toFixed(0)} MB\n`);
   }

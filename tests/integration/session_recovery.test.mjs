@@ -1,5 +1,6 @@
-// Scans fed through POST /api/v1/scans are on disk once acknowledged: a server killed with
-// SIGKILL restarts from its session directory with every scan, pose and the same map.
+// Scans fed through POST /api/v1/scans and annotations are on disk once acknowledged: a server
+// killed with SIGKILL restarts from its session directory with every scan, pose, annotation and
+// the same map, and publishes the annotations on DDS again for subscribers that join later.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
@@ -7,6 +8,7 @@ import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { startStack, requireEnv } from '../support/stack.mjs';
+import { startListener } from '../support/dds_listener.mjs';
 
 const cli = requireEnv('SCANPLAN_CLI');
 const world = join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples/worlds/yard.json');
@@ -62,6 +64,15 @@ test('acknowledged scans survive SIGKILL', async () => {
     return s.scans === 3 ? s : undefined;
   });
   const mapBefore = Buffer.from(await (await stack.api('GET', '/api/v1/map.drc')).arrayBuffer());
+  // Annotations: one withdrawn, and one acknowledged just before the kill.
+  const annotate = async (body) => {
+    const r = await stack.api('POST', '/api/v1/annotations', { body: JSON.stringify(body) });
+    assert.equal(r.status, 201);
+    return r.json();
+  };
+  const hazard = await annotate({ kind: 'hazard', x: -12, y: 3, z: 0, text: 'leaning wall' });
+  assert.equal((await stack.api('DELETE', `/api/v1/annotations/${hazard.id}`)).status, 200);
+  const victim = await annotate({ kind: 'victim', x: 4.5, y: -9.25, z: 0.3, text: 'child, calling out', by: 'Ann' });
   const tokens = { operator: stack.token, viewer: stack.viewerToken };
   const sessionDir = stack.dir;
   await stack.stop({ keepDir: true, signal: 'SIGKILL' });
@@ -80,4 +91,18 @@ test('acknowledged scans survive SIGKILL', async () => {
   assert.ok(mapAfter.equals(mapBefore), 'the page gets the same map after the restart');
   const next = await post(stack, 0);
   assert.equal((await next.json()).id, 4, 'ids continue after the restart');
+
+  const annotations = (await (await stack.api('GET', '/api/v1/annotations')).json()).annotations;
+  assert.deepEqual(annotations, [victim], 'the acknowledged annotation is back, the deleted one is not');
+  const listener = await startListener('SCANPLAN_ANNOTATION_LISTENER');
+  try {
+    const sample = await listener.waitFor('the annotation on DDS after the restart', (l) => l.id === victim.id);
+    assert.deepEqual([sample.kind, sample.x, sample.y, sample.z, sample.text, sample.author],
+      ['victim', 4.5, -9.25, 0.3, 'child, calling out', 'operator Ann']);
+    assert.ok(!listener.lines.some((l) => l.id === hazard.id), 'the deleted annotation is not republished');
+  } finally {
+    await listener.stop();
+  }
+  const more = await stack.api('POST', '/api/v1/annotations', { body: '{"kind":"blocked","x":0,"y":0,"z":0}' });
+  assert.equal((await more.json()).id, victim.id + 1, 'annotation ids continue after the restart');
 });

@@ -72,15 +72,22 @@ export async function startStack({ world, replay, timeScale = 600, seed = 1, bri
     ['--session', join(dir, 'session'), '--listen', '127.0.0.1:0', '--domain', domain,
      '--web', requireEnv('SCANPLAN_WEB_DIR')],
     { SCANPLAN_OPERATOR_TOKEN: token, SCANPLAN_VIEWER_TOKEN: viewerToken }, 'scanplan-server');
-  const bridge = withBridge && startProcess(
+  const launchBridge = (extraArgs = []) => startProcess(
     requireEnv('SCANPLAN_BRIDGE'),
     [...(replay ? ['--replay', replay] : ['--world', worldFile]),
-     '--domain', domain, '--time-scale', String(timeScale), '--seed', String(seed)],
+     '--domain', domain, '--time-scale', String(timeScale), '--seed', String(seed), ...extraArgs],
     {}, 'scanplan-bridge');
+  const bridge = withBridge && launchBridge();
   const procs = withBridge ? [server, bridge] : [server];
 
+  // A stack that fails to come up takes its processes down with it (a stray bridge would keep
+  // node, and so the test, running until ctest's timeout).
   const url = await waitFor('the server to listen',
-    async () => server.log.match(/listening on (http:\/\/[0-9.:]+)\//)?.[1], 15000, procs);
+    async () => server.log.match(/listening on (http:\/\/[0-9.:]+)\//)?.[1], 15000, procs)
+    .catch((e) => {
+      for (const p of procs) if (p.exitCode === null && p.signalCode === null) p.kill('SIGKILL');
+      throw e;
+    });
 
   const api = async (method, path, { auth = token, body } = {}) => {
     const headers = auth ? { Authorization: `Bearer ${auth}` } : {};
@@ -90,6 +97,13 @@ export async function startStack({ world, replay, timeScale = 600, seed = 1, bri
   const stack = {
     url, token, viewerToken, dir, server, bridge, api,
     waitFor: (what, fn, timeoutMs = 60000) => waitFor(what, fn, timeoutMs, procs),
+    // Another bridge on the same domain and world (e.g. one replacing a killed bridge); it is
+    // watched and stopped with the stack. A process killed on purpose does not fail waitFor.
+    startBridge(extraArgs = []) {
+      const b = launchBridge(extraArgs);
+      procs.push(b);
+      return b;
+    },
     async stop({ keepDir = false, signal = 'SIGTERM' } = {}) {
       for (const p of procs) if (p.exitCode === null && p.signalCode === null) p.kill(signal);
       const results = await Promise.all(procs.map((p) => p.exited));

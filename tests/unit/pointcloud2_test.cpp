@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "scanplan/msgs/pointcloud2.hpp"
+#include "scanplan/msgs/pose_array.hpp"
 #include "scanplan/msgs/pose_stamped.hpp"
 
 namespace scanplan::dds {
@@ -56,6 +57,32 @@ TEST(PoseStamped, RoundTripKeepsPoseAndYaw) {
   EXPECT_NEAR(q.x, 1.5, 1e-12);
   EXPECT_NEAR(q.yaw, p.yaw, 1e-12);
   EXPECT_NEAR(q.roll, 0, 1e-12);
+}
+
+TEST(PoseArray, HoldsEachPoseInOrderWithItsYaw) {
+  std::vector<Pose> poses(3);
+  for (int i = 0; i < 3; ++i) {
+    poses[i].x = i;
+    poses[i].y = -i;
+    poses[i].z = 0.5 * i;
+    poses[i].yaw = deg2rad(90.0 * i);
+  }
+  OwnedPoseArray msg;
+  to_pose_array(poses, "map", 7'000'000'001, msg);
+  EXPECT_STREQ(msg.msg.header.frame_id, "map");
+  EXPECT_EQ(stamp_ns(msg.msg.header.stamp), 7'000'000'001);
+  ASSERT_EQ(msg.msg.poses._length, 3u);
+  const auto& third = msg.msg.poses._buffer[2];
+  EXPECT_DOUBLE_EQ(third.position.x, 2);
+  EXPECT_DOUBLE_EQ(third.position.y, -2);
+  EXPECT_DOUBLE_EQ(third.position.z, 1);
+  // 180° about z: (x, y, z, w) = (0, 0, 1, 0) up to sign.
+  EXPECT_NEAR(std::abs(third.orientation.z), 1, 1e-12);
+  EXPECT_NEAR(third.orientation.w, 0, 1e-12);
+  EXPECT_FALSE(msg.msg.poses._release) << "the vector owns the poses";
+
+  to_pose_array({}, "map", 1, msg);
+  EXPECT_EQ(msg.msg.poses._length, 0u) << "an empty plan is an empty array";
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 
 #include "scanplan/core/session_store.hpp"
@@ -101,6 +102,50 @@ TEST_F(SessionDir, UnusableDirectoryIsReportedWithItsPath) {
     EXPECT_NE(std::string(e.what()).find(dir_.string()), std::string::npos) << e.what();
   }
   std::filesystem::remove(dir_);
+}
+
+TEST_F(SessionDir, AnnotationsSurviveReopeningAndDeletionsAreKeptOut) {
+  std::int64_t victim_ns = 0;
+  {
+    SessionStore s(dir_);
+    const Annotation v =
+        s.add_annotation("victim", 1.5, -2.25, 0.5, "two adults, responsive", "operator Ann");
+    EXPECT_EQ(v.id, 1);
+    EXPECT_GT(v.created_ns, 0);
+    EXPECT_EQ(v.created_at.size(), 24u) << v.created_at;  // 2026-11-02T10:11:12.345Z
+    victim_ns = v.created_ns;
+    EXPECT_EQ(s.add_annotation("hazard", 3, 4, 0, "", "operator").id, 2);
+    EXPECT_EQ(s.add_annotation("note", 5, 6, 1, "gas smell", "operator").id, 3);
+    EXPECT_TRUE(s.delete_annotation(2, "operator Bob"));
+    EXPECT_FALSE(s.delete_annotation(2, "operator Bob")) << "already deleted";
+    EXPECT_FALSE(s.delete_annotation(99, "operator")) << "never existed";
+  }
+  SessionStore s(dir_);
+  const auto list = s.annotations();
+  ASSERT_EQ(list.size(), 2u);
+  EXPECT_EQ(list[0].id, 1);
+  EXPECT_EQ(list[0].kind, "victim");
+  EXPECT_DOUBLE_EQ(list[0].y, -2.25);
+  EXPECT_EQ(list[0].text, "two adults, responsive");
+  EXPECT_EQ(list[0].author, "operator Ann");
+  EXPECT_EQ(list[0].created_ns, victim_ns);
+  EXPECT_EQ(list[1].id, 3);
+  EXPECT_EQ(s.add_annotation("blocked", 0, 0, 0, "", "operator").id, 4) << "ids are not reused";
+}
+
+TEST_F(SessionDir, InvalidAnnotationsAreRefusedAndNothingIsStored) {
+  SessionStore s(dir_);
+  EXPECT_THROW(s.add_annotation("rubble", 0, 0, 0, "", "operator"), SessionStoreError);
+  EXPECT_THROW(s.add_annotation("victim", std::nan(""), 0, 0, "", "operator"), SessionStoreError);
+  EXPECT_THROW(s.add_annotation("victim", 0, INFINITY, 0, "", "operator"), SessionStoreError);
+  EXPECT_THROW(
+      s.add_annotation("note", 0, 0, 0, std::string(kMaxAnnotationTextBytes + 1, 'a'), "operator"),
+      SessionStoreError);
+  EXPECT_TRUE(s.annotations().empty());
+  // Text is stored as given, quotes and all: statements bind values, never splice them.
+  const std::string tricky = "'); DROP TABLE annotations; --";
+  EXPECT_EQ(s.add_annotation("note", 0, 0, 0, tricky, "operator").text, tricky);
+  EXPECT_EQ(s.annotations().at(0).text, tricky);
 }
 
 }  // namespace

@@ -1,11 +1,13 @@
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "scanplan/core/point_cloud.hpp"
@@ -39,6 +41,24 @@ struct SessionEvent {
   std::string json;
 };
 
+// A mark the operator put on the map (DESIGN.md "REST": annotations).
+struct Annotation {
+  std::int64_t id = 0;
+  std::string kind;            // one of kAnnotationKinds
+  double x = 0, y = 0, z = 0;  // map frame, metres
+  std::string text;
+  std::string author;           // who made it, as decisions record it ("operator", "operator Ann")
+  std::int64_t created_ns = 0;  // since the epoch
+  std::string created_at;       // the same instant, UTC, ISO 8601
+};
+
+inline constexpr std::array<std::string_view, 4> kAnnotationKinds = {"victim", "hazard", "blocked",
+                                                                     "note"};
+// Enough for a short report ("two adults, one trapped under the stairs, responsive"); a longer
+// text is a document, not a mark on a map.
+inline constexpr std::size_t kMaxAnnotationTextBytes = 1000;
+inline constexpr std::size_t kMaxAnnotationAuthorBytes = 100;
+
 // A session on disk (DESIGN.md "Session directory"): session.sqlite in WAL mode plus one binary
 // PLY per scan under scans/. A scan is acknowledged only once both are durable: the PLY is
 // written to a temporary name, synced and renamed before its row commits, so a process killed
@@ -67,6 +87,18 @@ class SessionStore {
 
   // A key-value record of what happened (decisions, events), in order, as JSON text.
   std::int64_t append_event(const std::string& kind, const std::string& json);
+
+  // Stores a new annotation, committed (on disk) when this returns, and returns it with its id
+  // and creation time. Ids are never reused, even after a deletion. Throws SessionStoreError for
+  // an unknown kind, a non-finite coordinate or a text or author over the limits, so nothing
+  // invalid is ever stored.
+  Annotation add_annotation(const std::string& kind, double x, double y, double z,
+                            const std::string& text, const std::string& author);
+  // Marks annotation `id` deleted by `by` (the row stays, for the record); false when there is
+  // no such annotation or it was already deleted.
+  bool delete_annotation(std::int64_t id, const std::string& by);
+  // The annotations not deleted, oldest first.
+  std::vector<Annotation> annotations() const;
 
  private:
   void exec(const char* sql) const;

@@ -1,5 +1,8 @@
 #pragma once
 
+#include <cstdint>
+#include <vector>
+
 #include "scanplan/core/point_cloud.hpp"
 
 namespace scanplan {
@@ -15,5 +18,29 @@ namespace scanplan {
 // <= 0 returns the finite points unchanged. The output is ordered by voxel, so the same input
 // always gives the same output.
 PointCloud voxel_downsample(const PointCloud& cloud, double voxel_m);
+
+// A growing map thinned to one point per cube of side `voxel_m`, for sending the whole map
+// where bandwidth matters (the server's DDS map topic). Each scan added is thinned as
+// voxel_downsample does, colours kept; a cube the map already holds keeps its first point, so
+// the thinned map only grows and a subscriber sees settled areas stay put. Adding costs time
+// linear in the map's size (one merge of sorted lists), not a pass over every point so far.
+class VoxelMap {
+ public:
+  // Throws std::invalid_argument unless voxel_m > 0.
+  explicit VoxelMap(double voxel_m);
+  // Points in the map frame; non-finite points are left out. Points without colours get
+  // kUncolored.
+  void add(const PointCloud& cloud);
+  // Ordered by voxel, with one colour a point.
+  const PointCloud& cloud() const { return cloud_; }
+  double voxel_m() const { return voxel_m_; }
+
+  static constexpr Rgb kUncolored{128, 128, 128};
+
+ private:
+  double voxel_m_;
+  std::vector<std::uint64_t> keys_;  // sorted, parallel to cloud_
+  PointCloud cloud_;
+};
 
 }  // namespace scanplan

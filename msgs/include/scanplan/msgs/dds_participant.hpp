@@ -25,11 +25,26 @@ dds_return_t check(dds_return_t rc, std::string_view what);
 // CYCLONEDDS_URI, when set, is applied after these and so wins.
 std::string default_config();
 
+// How long a bridge may show no sign of life on DDS before the server counts it as lost.
+// Writers of scan data and status offer AUTOMATIC liveliness with this lease and the server's
+// readers request the same. Cyclone asserts AUTOMATIC liveliness by itself (a participant message
+// at 80 % of the lease, and every packet from the bridge renews it; the bridge also sends its
+// status once a second), so a bridge that is killed, hangs in the kernel or loses its link is
+// noticed within this time instead of after the 10 s participant lease, and a lost packet or two
+// on a radio link does not count as death. Requested ≥ offered is DDS's matching rule: a writer
+// offering a longer lease (a ROS 2 node's default is infinite) does not match these readers.
+inline constexpr std::chrono::milliseconds kBridgeLivelinessLease{2000};
+
 // How a topic's samples behave.
 enum class QosKind {
-  kScanData,  // reliable, keep the last few: scans are large and each one matters
+  kScanData,  // reliable, keep the last few: scans are large and each one matters; bridge lease
   kCommand,   // reliable, keep all (bounded): a lost command is a robot that never moves
-  kStatus,    // reliable, keep last 1: a newer status supersedes the older
+  kStatus,    // reliable, keep last 1: a newer status supersedes the older; bridge lease
+  // reliable, keep last 1 (per instance for keyed types), transient-local: state that supersedes
+  // itself and that a subscriber joining later must still get (the map, the plan, the goal, the
+  // annotations), as a ROS 1 "latched" topic. Readers must ask for transient-local too to be
+  // given the history.
+  kLatched,
 };
 
 class Participant {
@@ -43,7 +58,9 @@ class Participant {
   // One topic entity per name, created on first use.
   dds_entity_t topic(const dds_topic_descriptor_t& type, const std::string& name);
   dds_entity_t writer(const dds_topic_descriptor_t& type, const std::string& name, QosKind qos);
-  dds_entity_t reader(const dds_topic_descriptor_t& type, const std::string& name, QosKind qos);
+  // `listener` (may be null) is copied into the reader; its callbacks run on Cyclone's threads.
+  dds_entity_t reader(const dds_topic_descriptor_t& type, const std::string& name, QosKind qos,
+                      const dds_listener_t* listener = nullptr);
 
  private:
   dds_entity_t domain_ = 0;
