@@ -2,7 +2,8 @@
 // simulated robot at 1366×768: a viewer token sees the map, the candidates and the top view but no
 // action buttons; the measure tool gives the distance between two picked map points; the level of
 // detail draws what the budget allows; annotations are placed, stored and shown to others, or,
-// where the server has no /api/v1/annotations yet, the page says so (and that test is skipped).
+// where the server has no /api/v1/annotations yet, the page says so (and that test is skipped);
+// a robot whose bridge dies shows as lost.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { scanAndWait, startStack } from '../support/stack.mjs';
@@ -122,7 +123,9 @@ test('measure tool, level of detail and colour modes', { timeout: 60000 }, async
     await frames(page);
     t.diagnostic(`shot: ${await screenshot(page, 'measure.png')}`);
 
-    // Level of detail: a budget below the points held draws a share of every chunk.
+    // Level of detail: a budget below the points held draws a share of every chunk (the full
+    // budget once the camera is at rest: the clicks above count as touching it).
+    await page.waitForFunction(() => !window.scanplan.view.interacting);
     const lod = await page.evaluate(async () => {
       const { view } = window.scanplan;
       view.setBudget(50000);
@@ -227,9 +230,37 @@ test('annotations: placed on the map, stored, shown to others', { timeout: 60000
     assert.match(await page.locator('#annot-list').innerText(), /two people, responsive/);
     assert.ok((await page.locator('.annot-label.kind-victim').count()) >= 1, 'the mark shows in the 3-D view');
     await waitForData(viewer.page, 'the viewer to receive the annotation event', (n) => window.scanplan.annotations.items.size > n, before);
+    assert.equal(await viewer.page.locator('#annot-list .annot-delete').count(), 0, 'viewers cannot withdraw marks');
     await frames(page);
     t.diagnostic(`shot: ${await screenshot(page, 'annotations.png')}`);
+
+    // Withdrawn (after a confirmation): gone from both pages.
+    await page.locator(`#annot-list li[data-id="${mine.id}"] .annot-delete`).click();
+    await page.waitForSelector('#confirm[open]');
+    await page.click('#confirm-ok');
+    await waitForData(viewer.page, 'the withdrawal to reach the viewer', (id) => !window.scanplan.annotations.items.has(id), mine.id);
+    assert.ok(!(await page.evaluate((id) => window.scanplan.annotations.items.has(id), mine.id)));
     assert.deepEqual(operator.problems.pageErrors, []);
     assert.deepEqual(viewer.problems.pageErrors, []);
+  });
+});
+
+test('a robot that drops off the network shows as lost', { timeout: 60000 }, async (t) => {
+  await withBrowser(async (context) => {
+    const { page, problems } = await openPage(context, pageUrl(stack.viewerToken));
+    await loaded(page);
+    const health = await (await stack.api('GET', '/api/v1/health', { auth: null })).json();
+    if (!('bridges' in health) || !(await (await stack.api('GET', '/api/v1/session')).json()).robots?.robot1?.hasOwnProperty('connected')) {
+      t.skip('this server does not track bridge liveliness');
+      return;
+    }
+    stack.bridge.kill('SIGKILL'); // no goodbye: the liveliness lease runs out
+    await waitForData(page, 'the robot shown as lost', () => !!document.querySelector('#robots .chip.robot-lost'), null, 30000);
+    assert.match(await page.locator('#robots').innerText(), /robot1\s*LOST/);
+    assert.match(await page.locator('#status-message').innerText(), /robot1 LOST/);
+    assert.equal((await dataset(page)).lost, 'robot1');
+    await waitForData(page, 'the loss in the log', () => /robot1 LOST/.test(document.getElementById('log').textContent));
+    t.diagnostic(`shot: ${await screenshot(page, 'robot_lost.png')}`);
+    assert.deepEqual(problems.pageErrors, []);
   });
 });

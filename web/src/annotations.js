@@ -3,6 +3,7 @@
 // text, author, created_at}; others' marks arrive as {"type":"annotation", ...same fields} events.
 // A server without the endpoint (404) shows that annotations are unavailable; nothing breaks.
 import { ApiError, getJson, sendJson } from './api.js';
+import { confirmAction, operatorName } from './dialog.js';
 
 export const KINDS = ['victim', 'hazard', 'blocked', 'note'];
 const f1 = (v) => (Number.isFinite(v) ? v.toFixed(1) : '?');
@@ -82,6 +83,31 @@ export class AnnotationsPanel {
     this.onChange(this.list);
   }
 
+  /** annotation_deleted: the mark was withdrawn (the server keeps it on record). */
+  onDeleted(e) {
+    if (!this.items.delete(e.id)) return;
+    this.render();
+    this.onChange(this.list);
+  }
+
+  async remove(a) {
+    const ok = await confirmAction({
+      title: `Withdraw the ${a.kind} mark?`,
+      body: `“${a.text || a.kind}” at (${f1(a.x)}, ${f1(a.y)}) disappears from every screen; the session keeps it on record with your name.`,
+      confirm: 'Withdraw',
+      danger: true,
+    });
+    if (!ok) return;
+    try {
+      await sendJson(`/api/v1/annotations/${a.id}`, ok.by ? { by: ok.by } : {}, { method: 'DELETE' });
+      this.items.delete(a.id);
+      this.render();
+      this.onChange(this.list);
+    } catch (e) {
+      this.els.status.textContent = `not withdrawn: ${e.detail || e.message}`;
+    }
+  }
+
   /** Opens the form for a mark at a picked map point. */
   openForm(point, screen) {
     const f = this.els.form;
@@ -114,6 +140,10 @@ export class AnnotationsPanel {
       msg.textContent = 'choose what this mark is';
       return;
     }
+    if (kind === 'note' && !text) {
+      msg.textContent = 'a note needs a text';
+      return;
+    }
     if (text.length > 1000) {
       msg.textContent = `the text is ${text.length} characters; at most 1000`;
       return;
@@ -122,7 +152,8 @@ export class AnnotationsPanel {
     save.disabled = true;
     msg.textContent = 'saving…';
     try {
-      const a = await sendJson('/api/v1/annotations', { kind, ...this.placing, text });
+      const by = operatorName();
+      const a = await sendJson('/api/v1/annotations', { kind, ...this.placing, text, ...(by ? { by } : {}) });
       if (valid(a)) this.items.set(a.id, a);
       this.state = 'available';
       this.closeForm();
@@ -166,6 +197,16 @@ export class AnnotationsPanel {
       li.dataset.id = String(a.id);
       const head = el('div', 'annot-head');
       head.append(el('span', `kind kind-${a.kind}`, a.kind), el('span', 'where', `(${f1(a.x)}, ${f1(a.y)}, ${f1(a.z)})`));
+      if (this.operator) {
+        const del = el('button', 'annot-delete', '✕');
+        del.type = 'button';
+        del.title = 'withdraw this mark';
+        del.addEventListener('click', (ev) => {
+          ev.stopPropagation();
+          this.remove(a);
+        });
+        head.append(del);
+      }
       li.append(head);
       if (a.text) li.append(el('div', 'annot-text', a.text));
       const when = a.created_at ? new Date(a.created_at) : null;

@@ -14,6 +14,7 @@ const STATE_TEXT = {
   reached: 'reached',
   rejected: 'rejected',
   refused: 'refused by the robot',
+  interrupted: 'interrupted: robot lost',
   cancelled: 'cancelled',
   superseded: 'superseded',
 };
@@ -62,7 +63,7 @@ export class CandidatesPanel {
     }
     if (this.selected == null) {
       // Keep the eye on what matters: a move under way, else the best proposal.
-      const moving = this.list.find((c) => c.state === 'moving');
+      const moving = this.list.find((c) => c.state === 'moving' || c.state === 'interrupted');
       const best = this.list.find((c) => c.state === 'proposed');
       this.selected = (moving || best)?.id ?? null;
     }
@@ -138,7 +139,8 @@ export class CandidatesPanel {
       detail.append(title, grid);
       if (this.operator) {
         const actions = el('div', 'actions');
-        if (c.state === 'proposed') {
+        // An interrupted move (its robot's bridge was lost) may be approved again.
+        if (c.state === 'proposed' || c.state === 'interrupted') {
           const approve = el('button', 'primary', 'Approve move…');
           approve.id = 'approve';
           approve.type = 'button';

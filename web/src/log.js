@@ -19,6 +19,14 @@ function describe(e) {
       return `${e.robot} refused ${who}${e.message ? `: ${e.message}` : ''}`;
     case 'scan_requested':
       return `scan requested from ${e.robot}${e.after ? ` (after ${e.after})` : ''}`;
+    case 'interrupted':
+      return `move to ${who} interrupted: ${e.message || `${e.robot} lost`}`;
+    case 'robot_lost':
+      return `${e.robot} LOST${e.reason ? `: ${e.reason}` : ''}`;
+    case 'robot_back':
+      return `${e.robot} is back`;
+    case 'scan_failed':
+      return `scan by ${e.robot} failed${e.reason ? `: ${e.reason}` : ''}`;
     case 'goal':
       return `proposed custom point ${who} at (${f1(e.x)}, ${f1(e.y)}), F ${Math.round(e.f ?? 0)}`;
     default:

@@ -156,7 +156,9 @@ function render() {
   setText($('stat-points'), pts);
 
   let msg = '';
+  const lost = mission.lostRobots();
   if (err) msg = err.auth && !getToken() ? `${err.message}: open the page as /?token=YOUR_TOKEN` : err.message;
+  else if (lost.length) msg = `${lost.map((r) => r.id).join(', ')} LOST: no contact with the robot (see Mission)`;
   else if (chunks.error) msg = chunks.error.message;
   else if (chunks.pendingCount || chunks.syncing) {
     const total = state.scans.length || state.session?.scans || 0;
@@ -166,7 +168,8 @@ function render() {
     msg = state.session.bridges ? 'waiting for the first scan' : 'waiting for the first scan: no robot is connected';
   }
   setText($('status-message'), msg);
-  $('status-message').classList.toggle('error', !!err || !!chunks.error);
+  $('status-message').classList.toggle('error', !!err || !!chunks.error || lost.length > 0);
+  body.dataset.lost = lost.map((r) => r.id).join(',');
   renderBanner();
 }
 
@@ -415,6 +418,25 @@ function onEvent(e) {
       break;
     case 'annotation':
       annotations.onEvent(e);
+      break;
+    case 'annotation_deleted':
+      annotations.onDeleted(e);
+      break;
+    case 'robot_lost':
+      mission.onRobotLost(e);
+      render();
+      log.add({ ...e, kind: 'robot_lost' });
+      refreshCandidates();
+      break;
+    case 'robot_back':
+      mission.onRobotBack(e);
+      render();
+      log.add({ ...e, kind: 'robot_back' });
+      refreshCandidates();
+      break;
+    case 'scan_failed':
+      mission.onScanFailed(e);
+      log.add({ ...e, kind: 'scan_failed' });
       break;
     case 'binary_dropped':
       // The server dropped chunks for a slow link: fetch those scans over REST.

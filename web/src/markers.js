@@ -24,6 +24,7 @@ export const STATE_COLORS = {
   reached: 0x3fb950,
   rejected: 0x6e7681,
   refused: 0xf85149,
+  interrupted: 0xff7b29,
   cancelled: 0x6e7681,
   superseded: 0x6e7681,
 };

@@ -10,6 +10,7 @@ const f2 = (v) => (Number.isFinite(v) ? v.toFixed(2) : '–');
 
 const ROBOT_TEXT = {
   idle: 'idle',
+  offline: 'offline',
   moving: 'driving',
   arrived: 'arrived',
   refused: 'refused the move',
@@ -43,7 +44,17 @@ export class MissionPanel {
   setSession(s) {
     this.bridges = s.bridges ?? 0;
     for (const [id, r] of Object.entries(s.robots || {})) {
-      this.robots[id] = { ...(this.robots[id] || {}), state: r.state, message: r.message, pose: r.pose, command_id: r.command_id };
+      this.robots[id] = {
+        ...(this.robots[id] || {}),
+        state: r.state,
+        message: r.message,
+        pose: r.pose,
+        command_id: r.command_id,
+        // Servers without bridge liveliness have no `connected`: take the robot as connected.
+        connected: r.connected !== false,
+        lostAt: r.lost_at || null,
+        lostReason: r.lost_reason || '',
+      };
       if (r.scan && r.scan.state === 'scanning') this.scan = { robot: id, ...r.scan };
       else if (!this.scan && r.scan && r.scan.state !== 'idle') this.scan = { robot: id, ...r.scan };
     }
@@ -52,6 +63,24 @@ export class MissionPanel {
 
   onRobotStatus(e) {
     this.robots[e.robot] = { ...(this.robots[e.robot] || {}), state: e.state, message: e.message, pose: e.pose, command_id: e.command_id };
+    this.render();
+  }
+
+  /** robot_lost: the robot's bridge stopped asserting its liveliness, or shut down. */
+  onRobotLost(e) {
+    this.robots[e.robot] = { ...(this.robots[e.robot] || {}), connected: false, lostAt: e.lost_at || e.at, lostReason: e.reason || '' };
+    this.render();
+  }
+
+  onRobotBack(e) {
+    this.robots[e.robot] = { ...(this.robots[e.robot] || {}), connected: true, lostAt: null, lostReason: '' };
+    this.render();
+  }
+
+  /** scan_failed: the scan under way was lost with its bridge; nothing of it reaches the map. */
+  onScanFailed(e) {
+    this.scan = { robot: e.robot, state: 'failed', fraction: e.fraction ?? 0, message: e.reason || 'the scan failed', command_id: e.command_id };
+    this.stage = '';
     this.render();
   }
 
@@ -113,6 +142,13 @@ export class MissionPanel {
     this.render();
   }
 
+  /** Robots whose bridge is lost: [{id, lostAt, lostReason}]. */
+  lostRobots() {
+    return Object.entries(this.robots)
+      .filter(([, r]) => r.connected === false)
+      .map(([id, r]) => ({ id, lostAt: r.lostAt, lostReason: r.lostReason }));
+  }
+
   robotPose(id) {
     return this.robots[id]?.pose || null;
   }
@@ -134,10 +170,18 @@ export class MissionPanel {
       const name = document.createElement('b');
       name.textContent = id;
       const chip = document.createElement('span');
-      chip.className = `chip robot-${r.state}`;
-      chip.textContent = ROBOT_TEXT[r.state] ?? r.state;
+      const lost = r.connected === false;
+      chip.className = lost ? 'chip robot-lost' : `chip robot-${r.state}`;
+      chip.textContent = lost ? 'LOST' : ROBOT_TEXT[r.state] ?? r.state;
       line.append(name, chip);
+      line.classList.toggle('lost', lost);
       let extra = r.message || '';
+      if (lost) {
+        const since = r.lostAt ? new Date(r.lostAt) : null;
+        const when = since && !Number.isNaN(since.getTime()) ? ` since ${since.toLocaleTimeString('en-GB', { hour12: false })}` : '';
+        extra = `no contact${when}${r.lostReason ? `: ${r.lostReason}` : ''}`;
+        line.title = extra;
+      }
       if (r.state === 'moving' && this.goalDistance != null) extra = `${this.goalDistance.toFixed(1)} m to go${extra ? ` · ${extra}` : ''}`;
       if (extra) {
         const m = document.createElement('span');
@@ -176,7 +220,7 @@ export class MissionPanel {
     }
     match.title = this.matchHistory().join('\n');
     scanHere.hidden = !this.operator;
-    scanHere.disabled = !this.bridges || (s && s.state === 'scanning');
+    scanHere.disabled = !this.bridges || (!!s && s.state === 'scanning');
     message.hidden = !message.textContent;
   }
 

@@ -356,8 +356,8 @@ export class MapView {
   }
 
   /**
-   * The map point under a pixel of the view (client coordinates), or null: the drawn point nearest
-   * the camera within a few pixels of the ray.
+   * The map point under a pixel of the view (client coordinates), or null: of the drawn points
+   * within a few pixels of the ray, the one nearest the cursor on the surface nearest the camera.
    */
   pick(clientX, clientY, radiusPx = 6) {
     if (!this.chunks.size) return null;
@@ -371,8 +371,22 @@ export class MapView {
     ray.params.Points = { threshold: Math.max(0.02, radiusPx * perPx) };
     const hits = ray.intersectObjects([...this.chunks.values()].map((c) => c.points), false);
     if (!hits.length) return null;
-    const h = hits[0];
-    return { point: h.point.clone(), scan: h.object.userData.scan };
+    // The front surface: hits not much farther than the nearest one. Of those, the one nearest
+    // the cursor (smallest angle off the ray), not merely the nearest to the camera: at a grazing
+    // angle the tolerance cone covers metres of ground.
+    const front = hits[0].distance;
+    const depth = 0.5 + 0.02 * front;
+    let best = hits[0];
+    let bestAngle = Infinity;
+    for (const h of hits) {
+      if (h.distance > front + depth) break; // sorted by distance
+      const angle = h.distanceToRay / Math.max(h.distance, 1e-6);
+      if (angle < bestAngle) {
+        best = h;
+        bestAngle = angle;
+      }
+    }
+    return { point: best.point.clone(), scan: best.object.userData.scan };
   }
 
   _installClick() {
