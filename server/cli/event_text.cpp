@@ -41,12 +41,14 @@ std::string match_done(const json& e) {
   std::string text = "scan " + str(e, "scan") + ": " + str(e, "method") + " " +
                      (e.value("converged", false) ? "converged" : "did not converge") + ", score " +
                      fixed(num(e, "score"), 1) + ", rmse " + fixed(num(e, "rmse"), 3) + " m";
-  if (const auto c = e.find("correction"); c != e.end() && c->is_object()) {
+  const bool applied = e.value("applied", false);
+  // A match that was not applied leaves the estimate as it was; its correction says nothing.
+  if (const auto c = e.find("correction"); applied && c != e.end() && c->is_object()) {
     text += ", correction dx " + signed_fixed(num(*c, "x"), 2) + " dy " +
             signed_fixed(num(*c, "y"), 2) + " dz " + signed_fixed(num(*c, "z"), 2) + " m dyaw " +
             signed_fixed(num(*c, "yaw_deg"), 1) + " deg";
   }
-  text += e.value("applied", false) ? " (applied)" : " (NOT applied: the estimate is kept)";
+  text += applied ? " (applied)" : " (NOT applied: the robot's estimate is kept)";
   text += ", " + fixed(num(e, "time_ms"), 0) + " ms";
   return with_message(text, e);
 }

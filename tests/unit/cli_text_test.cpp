@@ -148,6 +148,12 @@ TEST(EventText, DescribesEachEventType) {
                  "correction":{"x":0.31,"y":-0.12,"z":0.01,"yaw_deg":1.2}})"),
             "scan 2: ndt-icp converged, score 123.4, rmse 0.045 m, correction dx +0.31 dy -0.12 "
             "dz +0.01 m dyaw +1.2 deg (applied), 350 ms");
+  EXPECT_EQ(d(R"({"type":"match_done","scan":3,"method":"ndt-icp","converged":false,
+                 "applied":false,"score":8996.2,"rmse":0.157,"time_ms":29,
+                 "message":"the match moved the scan 17.4 m",
+                 "correction":{"x":0,"y":0,"z":0,"yaw_deg":0}})"),
+            "scan 3: ndt-icp did not converge, score 8996.2, rmse 0.157 m (NOT applied: the "
+            "robot's estimate is kept), 29 ms: the match moved the scan 17.4 m");
   EXPECT_EQ(d(R"({"type":"map_updated","scan":2,"points":5,"completed_m2":1.4,
                  "low_resolution_m2":2,"unscanned_m2":3,"movable_m2":4})"),
             "scan 2 is in the map: completed 1 m2, low-res 2 m2, unscanned 3 m2, movable 4 m2");
