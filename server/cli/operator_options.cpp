@@ -35,6 +35,13 @@ void run_operator_command(const std::string& name, const std::function<void()>& 
     std::cerr << "scanplan " << name << ": the server's answer is not as documented (" << e.what()
               << "); are scanplan and scanplan-server the same version?" << std::endl;
     code = ExitCode::kFailure;
+  } catch (const HttpClientError& e) {
+    const OperatorError mapped = error_for_transport(e);
+    std::cerr << "scanplan " << name << ": " << mapped.what() << std::endl;
+    code = mapped.code();
+  } catch (const std::exception& e) {
+    std::cerr << "scanplan " << name << ": " << e.what() << std::endl;
+    code = ExitCode::kFailure;
   }
   if (code != ExitCode::kOk) throw CLI::RuntimeError(to_int(code));
 }

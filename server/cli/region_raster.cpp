@@ -24,9 +24,16 @@ constexpr Fill kFills[] = {
 RegionRaster decode_regions_png(const std::string& png, double target_min_x, double target_min_y,
                                 double target_max_x, double target_max_y, double cell_m,
                                 int px_per_cell) {
-  const cv::Mat bytes(1, static_cast<int>(png.size()), CV_8U,
-                      const_cast<char*>(png.data()));  // imdecode only reads
-  const cv::Mat img = cv::imdecode(bytes, cv::IMREAD_COLOR);
+  cv::Mat img;
+  if (!png.empty()) {
+    const cv::Mat bytes(1, static_cast<int>(png.size()), CV_8U,
+                        const_cast<char*>(png.data()));  // imdecode only reads
+    try {
+      img = cv::imdecode(bytes, cv::IMREAD_COLOR);
+    } catch (const cv::Exception&) {
+      img.release();  // reported below as any undecodable answer
+    }
+  }
   if (img.empty()) throw std::runtime_error("the regions layer is not a PNG image");
   // The grid of region_segmentation.cpp: cells from floor(min / cell) to floor(max / cell).
   const double x0 = std::floor(target_min_x / cell_m), y0 = std::floor(target_min_y / cell_m);

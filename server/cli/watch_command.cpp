@@ -86,12 +86,12 @@ std::string follow(WebSocketClient& ws, EventPrinter& printer, const InterruptSi
 }
 
 void run_watch(const WatchArgs& a) {
-  const OperatorClient client(a.o);
-  const ServerUrl url = parse_server_url(a.o.server);
-  // Listing candidates after plan_done must not hold the event stream up for long.
+  // Also checks the token and the URL before anything else. Listing candidates after plan_done
+  // must not hold the event stream up for long, hence its shorter timeout.
   OperatorOptions fetch_options = a.o;
   fetch_options.timeout_s = std::min(a.o.timeout_s, 10.0);
   const OperatorClient fetcher(fetch_options);
+  const ServerUrl url = parse_server_url(a.o.server);
   const InterruptSignals interrupt;
   EventPrinter printer(
       std::cout, std::cerr, {a.o.json, isatty(STDOUT_FILENO) == 1, a.top},
@@ -112,11 +112,13 @@ void run_watch(const WatchArgs& a) {
     try {
       ws.emplace(WebSocketClient::connect(url, "/api/v1/events", headers, a.o.timeout()));
     } catch (const WebSocketRefusedError& e) {
+      if (interrupt.raised()) break;
       OperatorError err = error_for_status(e.status(), e.body(), action, url.base);
       // A refused token will not be accepted on a retry; a busy server (503) may be.
       if (!ever_connected || e.status() < 500) throw err;
       failure = err.what();
     } catch (const HttpClientError& e) {
+      if (interrupt.raised()) break;  // Ctrl-C interrupted the attempt
       if (!ever_connected) throw error_for_transport(e);
       failure = e.what();
     }

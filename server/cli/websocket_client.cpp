@@ -192,8 +192,8 @@ WebSocketClient WebSocketClient::connect(const ServerUrl& url, const std::string
       throw HttpClientError(HttpClientError::Kind::kNotHttp,
                             "the answer from " + url.base + " has an overlong head");
     }
+    // EINTR is not retried: a Ctrl-C while the server is slow to answer ends the attempt.
     const ssize_t n = ::recv(fd.get(), buf, sizeof buf, 0);
-    if (n < 0 && errno == EINTR) continue;
     if (n < 0) {
       throw HttpClientError(
           HttpClientError::Kind::kNoAnswer,
