@@ -132,6 +132,7 @@ void run_watch(const WatchArgs& a) {
           catch_up = "; the session now has " + s.at("scans").dump() +
                      " scans (scanplan status and candidates show the rest)";
         } catch (const std::exception&) {
+          // The catch-up figure is a courtesy; the event stream is what matters.
         }
         printer.connection("connected", "reconnected to " + url.base + " after " +
                                             seconds_text(Clock::now() - *lost_at) +
