@@ -1,25 +1,16 @@
 #include "http_client.hpp"
 
-#include <netdb.h>
 #include <sys/socket.h>
-#include <sys/time.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstring>
-#include <memory>
+
+#include "tcp_connect.hpp"
 
 namespace scanplan::cli {
 namespace {
-
-struct Fd {
-  int fd = -1;
-  ~Fd() {
-    if (fd >= 0) ::close(fd);
-  }
-};
 
 std::string lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -29,70 +20,39 @@ std::string lower(std::string s) {
 }  // namespace
 
 HttpClient::HttpClient(const std::string& base, std::chrono::milliseconds timeout)
-    : base_(base), timeout_(timeout) {
-  const std::string prefix = "http://";
-  if (base.rfind(prefix, 0) != 0) {
-    throw HttpClientError("server URL '" + base + "' must start with http://");
-  }
-  std::string hostport = base.substr(prefix.size());
-  if (const auto slash = hostport.find('/'); slash != std::string::npos) hostport.resize(slash);
-  const auto colon = hostport.rfind(':');
-  host_ = colon == std::string::npos ? hostport : hostport.substr(0, colon);
-  port_ = colon == std::string::npos ? "80" : hostport.substr(colon + 1);
-  if (host_.empty() || port_.empty())
-    throw HttpClientError("server URL '" + base + "' has no host");
-}
+    : url_(parse_server_url(base)), timeout_(timeout) {}
 
 HttpResult HttpClient::request(const std::string& method, const std::string& path,
                                const std::map<std::string, std::string>& headers,
                                const std::string& body) const {
-  addrinfo hints{};
-  hints.ai_socktype = SOCK_STREAM;
-  addrinfo* found = nullptr;
-  if (const int rc = getaddrinfo(host_.c_str(), port_.c_str(), &hints, &found); rc != 0) {
-    throw HttpClientError("cannot resolve " + host_ + ": " + gai_strerror(rc));
-  }
-  std::unique_ptr<addrinfo, decltype(&freeaddrinfo)> addrs(found, freeaddrinfo);
-  Fd sock;
-  std::string last_error = "no address";
-  for (addrinfo* a = found; a; a = a->ai_next) {
-    sock.fd = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
-    if (sock.fd < 0) continue;
-    timeval tv{static_cast<time_t>(timeout_.count() / 1000),
-               static_cast<suseconds_t>((timeout_.count() % 1000) * 1000)};
-    setsockopt(sock.fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-    setsockopt(sock.fd, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
-    if (::connect(sock.fd, a->ai_addr, a->ai_addrlen) == 0) break;
-    last_error = std::strerror(errno);
-    ::close(sock.fd);
-    sock.fd = -1;
-  }
-  if (sock.fd < 0) {
-    throw HttpClientError("cannot reach the server at " + base_ + ": " + last_error +
-                          " (is scanplan-server running?)");
-  }
-
-  std::string req = method + " " + path + " HTTP/1.1\r\nHost: " + host_ + ":" + port_ +
+  const http::UniqueFd sock = connect_tcp(url_, timeout_);
+  const std::string& base = url_.base;
+  std::string req = method + " " + path + " HTTP/1.1\r\nHost: " + url_.host + ":" + url_.port +
                     "\r\nConnection: close\r\nContent-Length: " + std::to_string(body.size()) +
                     "\r\n";
   for (const auto& [k, v] : headers) req += k + ": " + v + "\r\n";
   req += "\r\n";
   req += body;
   for (std::size_t sent = 0; sent < req.size();) {
-    const ssize_t n = ::send(sock.fd, req.data() + sent, req.size() - sent, MSG_NOSIGNAL);
+    const ssize_t n = ::send(sock.get(), req.data() + sent, req.size() - sent, MSG_NOSIGNAL);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) throw HttpClientError("sending to " + base_ + " failed: " + std::strerror(errno));
+    if (n <= 0) {
+      throw HttpClientError(HttpClientError::Kind::kNoAnswer,
+                            "sending to " + base + " failed: " + std::strerror(errno));
+    }
     sent += static_cast<std::size_t>(n);
   }
 
   std::string raw;
   char buf[65536];
   for (;;) {
-    const ssize_t n = ::recv(sock.fd, buf, sizeof buf, 0);
+    const ssize_t n = ::recv(sock.get(), buf, sizeof buf, 0);
     if (n < 0 && errno == EINTR) continue;
     if (n < 0) {
-      throw HttpClientError("no answer from " + base_ + ": " +
-                            (errno == EAGAIN ? std::string("timed out") : std::strerror(errno)));
+      throw HttpClientError(
+          HttpClientError::Kind::kNoAnswer,
+          "no answer from " + base + ": " +
+              (errno == EAGAIN ? std::string("timed out") : std::strerror(errno)));
     }
     if (n == 0) break;
     raw.append(buf, static_cast<std::size_t>(n));
@@ -100,7 +60,9 @@ HttpResult HttpClient::request(const std::string& method, const std::string& pat
 
   const auto head_end = raw.find("\r\n\r\n");
   if (head_end == std::string::npos || raw.compare(0, 7, "HTTP/1.") != 0) {
-    throw HttpClientError("the answer from " + base_ + " is not HTTP");
+    throw HttpClientError(HttpClientError::Kind::kNotHttp,
+                          raw.empty() ? base + " closed the connection without an answer"
+                                      : "the answer from " + base + " is not HTTP");
   }
   HttpResult r;
   r.status = std::atoi(raw.c_str() + 9);
@@ -122,7 +84,10 @@ HttpResult HttpClient::request(const std::string& method, const std::string& pat
     std::size_t p = 0;
     for (;;) {
       const auto eol = payload.find("\r\n", p);
-      if (eol == std::string::npos) throw HttpClientError("broken chunked answer from " + base_);
+      if (eol == std::string::npos) {
+        throw HttpClientError(HttpClientError::Kind::kNotHttp,
+                              "broken chunked answer from " + base);
+      }
       const std::size_t size = std::stoul(payload.substr(p, eol - p), nullptr, 16);
       if (size == 0) break;
       out.append(payload, eol + 2, size);

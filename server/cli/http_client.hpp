@@ -2,15 +2,12 @@
 
 #include <chrono>
 #include <map>
-#include <stdexcept>
 #include <string>
 
-namespace scanplan::cli {
+#include "http_client_error.hpp"
+#include "server_url.hpp"
 
-class HttpClientError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+namespace scanplan::cli {
 
 struct HttpResult {
   int status = 0;
@@ -27,13 +24,14 @@ class HttpClient {
   explicit HttpClient(const std::string& base,
                       std::chrono::milliseconds timeout = std::chrono::seconds(30));
 
+  // Throws HttpClientError when no HTTP answer arrives; any status is an answer.
   HttpResult request(const std::string& method, const std::string& path,
                      const std::map<std::string, std::string>& headers = {},
                      const std::string& body = {}) const;
-  const std::string& base() const { return base_; }
+  const std::string& base() const { return url_.base; }
 
  private:
-  std::string base_, host_, port_;
+  ServerUrl url_;
   std::chrono::milliseconds timeout_;
 };
 

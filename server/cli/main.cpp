@@ -4,10 +4,14 @@
 
 #include <iostream>
 
+#include "candidates_command.hpp"
+#include "decision_command.hpp"
 #include "register_command.hpp"
 #include "replay_command.hpp"
 #include "scan_command.hpp"
 #include "simulate_command.hpp"
+#include "status_command.hpp"
+#include "watch_command.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"scanplan: offline tools and terminal operator for the scanplan workstation"};
@@ -16,6 +20,11 @@ int main(int argc, char** argv) {
   scanplan::cli::add_register_command(app);
   scanplan::cli::add_replay_command(app);
   scanplan::cli::add_simulate_command(app);
+  // The terminal operator: a client of a running scanplan-server's REST and WebSocket API.
+  scanplan::cli::add_status_command(app);
+  scanplan::cli::add_candidates_command(app);
+  scanplan::cli::add_decision_commands(app);
+  scanplan::cli::add_watch_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

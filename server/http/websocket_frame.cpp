@@ -48,8 +48,9 @@ bool is_valid_close_code(std::uint16_t code) {
   return (code >= 1000 && code <= 1003) || (code >= 1007 && code <= 1014);
 }
 
-WebSocketFrameParser::WebSocketFrameParser(std::size_t max_message_bytes)
-    : max_message_bytes_(max_message_bytes) {}
+WebSocketFrameParser::WebSocketFrameParser(std::size_t max_message_bytes,
+                                           WebSocketFrameSender sender)
+    : max_message_bytes_(max_message_bytes), masked_(sender == WebSocketFrameSender::kClient) {}
 
 bool WebSocketFrameParser::fail(std::uint16_t code, std::string message) {
   state_ = State::kError;
@@ -79,13 +80,14 @@ std::size_t WebSocketFrameParser::feed(std::string_view data) {
       const unsigned char length_bits = header_[1] & kLengthBits;
       const std::size_t length_bytes =
           length_bits == kLength64 ? 8 : (length_bits == kLength16 ? 2 : 0);
-      // Checked before the rest arrives so that an unmasked frame fails at once.
-      if (header_size_ == 2 && (header_[1] & kMaskBit) == 0) {
+      // Checked before the rest arrives so that a wrongly masked frame fails at once.
+      if (header_size_ == 2 && ((header_[1] & kMaskBit) != 0) != masked_) {
         fail(websocket_close::kProtocolError,
-             "client frames must be masked (RFC 6455 §5.1); this frame is not");
+             masked_ ? "client frames must be masked (RFC 6455 §5.1); this frame is not"
+                     : "server frames must not be masked (RFC 6455 §5.1); this frame is");
         break;
       }
-      if (header_size_ < 2 + length_bytes + 4) continue;
+      if (header_size_ < 2 + length_bytes + (masked_ ? 4 : 0)) continue;
       if (!on_header()) break;
       if (remaining_ == 0) on_frame_end();
       continue;
@@ -96,7 +98,7 @@ std::size_t WebSocketFrameParser::feed(std::string_view data) {
     std::string& sink = is_control(frame_opcode_) ? control_ : message_;
     const std::size_t start = sink.size();
     sink.append(data.data() + pos, n);
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = 0; masked_ && i < n; ++i) {
       sink[start + i] = static_cast<char>(static_cast<unsigned char>(sink[start + i]) ^
                                           mask_[(frame_offset_ + i) & 3]);
     }
@@ -134,7 +136,7 @@ bool WebSocketFrameParser::on_header() {
                   "64-bit payload length has its most significant bit set (RFC 6455 §5.2)");
     }
   }
-  std::copy_n(header_.begin() + static_cast<std::ptrdiff_t>(at), 4, mask_.begin());
+  if (masked_) std::copy_n(header_.begin() + static_cast<std::ptrdiff_t>(at), 4, mask_.begin());
 
   if (is_control(opcode)) {
     if (!fin) return fail(websocket_close::kProtocolError, "control frames must not be fragmented");

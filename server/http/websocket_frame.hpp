@@ -41,14 +41,19 @@ inline constexpr std::size_t kMaxControlPayload = 125;
 // APIs, to say that no code arrived.
 bool is_valid_close_code(std::uint16_t code);
 
-// One message received from a client: a whole (reassembled) data message or one control frame.
+// One message received from the peer: a whole (reassembled) data message or one control frame.
 struct WebSocketMessage {
   WebSocketOpcode opcode = WebSocketOpcode::kText;  // never kContinuation
   std::string payload;           // for kClose: only the reason text (valid UTF-8), without the code
   std::uint16_t close_code = 0;  // for kClose: the code received, or kNoStatus when there was none
 };
 
-// Incremental parser for the frames a client sends to a server (RFC 6455 §5).
+// Who sent the frames a parser reads. Client frames must be masked and server frames must not
+// be (RFC 6455 §5.1); the server's hub reads client frames, the CLI's `watch` reads server frames.
+enum class WebSocketFrameSender { kClient, kServer };
+
+// Incremental parser for WebSocket frames (RFC 6455 §5): by default those a client sends to a
+// server; with WebSocketFrameSender::kServer, those a server sends to a client.
 //
 // Bytes arrive in arbitrary pieces; feed() stops after each complete message so the caller can
 // take() it, then feeds the rest again, as with RequestParser. Fragmented data messages are
@@ -56,15 +61,17 @@ struct WebSocketMessage {
 // A message larger than max_message_bytes is refused from its frame header alone, before its
 // payload is buffered. No extension is negotiated, so the RSV bits must be zero.
 //
-// Errors carry the close code to fail the connection with: 1002 for a protocol violation (an
-// unmasked frame, a reserved opcode or bit, a fragmented or oversized control frame, a stray or
-// missing continuation, a malformed close frame), 1007 for text that is not UTF-8 and 1009 for a
-// message over the limit. After an error the stream cannot be resynchronised.
+// Errors carry the close code to fail the connection with: 1002 for a protocol violation (a
+// frame masked the wrong way for its sender, a reserved opcode or bit, a fragmented or oversized
+// control frame, a stray or missing continuation, a malformed close frame), 1007 for text that is
+// not UTF-8 and 1009 for a message over the limit. After an error the stream cannot be
+// resynchronised.
 class WebSocketFrameParser {
  public:
   enum class State { kIncomplete, kComplete, kError };
 
-  explicit WebSocketFrameParser(std::size_t max_message_bytes);
+  explicit WebSocketFrameParser(std::size_t max_message_bytes,
+                                WebSocketFrameSender sender = WebSocketFrameSender::kClient);
 
   // Consumes a prefix of data and returns its length. Stops early when a message is complete
   // (state kComplete) or at an error (state kError); consumes nothing in those states.
@@ -88,6 +95,7 @@ class WebSocketFrameParser {
   bool on_frame_end();
 
   std::size_t max_message_bytes_;
+  bool masked_;  // whether frames must carry a mask (client frames) or must not (server frames)
   State state_ = State::kIncomplete;
   std::array<unsigned char, 14> header_{};  // 2 fixed + up to 8 length + 4 mask bytes
   std::size_t header_size_ = 0;

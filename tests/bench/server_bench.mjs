@@ -53,6 +53,7 @@ ws.on('message', (data, isBinary) => {
 const nextEvent = (match) => new Promise((resolve) => waiting.push((e, at) => match(e) && (resolve({ e, at }), true)));
 
 const rows = [];
+let anchor = null;
 try {
   for (let k = 0; k < poses.length; ++k) {
     const [x, y, z, yaw] = poses[k];
@@ -76,10 +77,18 @@ try {
     await whole.arrayBuffer();
     const wholeAt = performance.now();
     if (whole.headers.get('x-scanplan-last-scan') !== String(k + 1)) throw new Error('map.drc lags');
+    // Where the scan was placed against where it really was, in the frame anchored at the first
+    // scan's reported pose (its error cannot be seen from the scans): the matcher's accuracy.
+    const placed = (await (await stack.api('GET', `/api/v1/scans/${k + 1}`)).json()).placed;
+    if (k === 0) anchor = { dx: placed.x - x, dy: placed.y - y, dyaw: placed.yaw_deg - yaw };
+    const c = Math.cos((anchor.dyaw * Math.PI) / 180), s = Math.sin((anchor.dyaw * Math.PI) / 180);
+    const [x0, y0] = poses[0];
+    const ex = x0 + anchor.dx + c * (x - x0) - s * (y - y0), ey = y0 + anchor.dy + s * (x - x0) + c * (y - y0);
+    const placedErrorM = Math.hypot(placed.x - ex, placed.y - ey);
     rows.push({ scan: k + 1, points: info.points, ply_mb: body.length / 1e6, ms_to_stored: stored - t0,
       ms_to_candidates: at - t0, ms_match: match?.time_ms ?? 0, match_applied: match?.applied ?? null,
       ms_plan: plan.plan_ms, candidates: plan.candidates, match_message: match?.message ?? null,
-      ms_to_whole_map: wholeAt - t0, ...rssKb(stack.server.pid) });
+      ms_to_whole_map: wholeAt - t0, placed_error_m: placedErrorM, ...rssKb(stack.server.pid) });
     process.stderr.write(`scan ${k + 1}: ${info.points} points, candidates after ${(at - t0).toFixed(0)} ms, ` +
       `rss ${(rssKb(stack.server.pid).rss / 1024).toFixed(0)} MB\n`);
   }
@@ -100,6 +109,9 @@ console.log(JSON.stringify({
   ms_to_candidates_max: Math.max(...rows.map((r) => r.ms_to_candidates)),
   scans_over_250k_points: big.length,
   ms_to_candidates_over_250k_max: big.length ? Math.max(...big.map((r) => r.ms_to_candidates)) : null,
+  placed_error_m_median: median(rows.map((r) => r.placed_error_m)),
+  placed_error_m_max: Math.max(...rows.map((r) => r.placed_error_m)),
+  matches_applied: rows.filter((r) => r.match_applied).length,
   rss_mb_final: rows.at(-1).rss / 1024,
   rss_mb_peak: Math.max(...rows.map((r) => r.hwm)) / 1024,
   rows,

@@ -1,0 +1,56 @@
+#include "candidate_table.hpp"
+
+#include <cstdio>
+
+#include "text_format.hpp"
+
+namespace scanplan::cli {
+
+std::vector<std::string> render_candidate_table(const nlohmann::json& answer) {
+  std::vector<std::string> out;
+  const nlohmann::json& plan = answer.at("plan");
+  if (plan.is_null()) {
+    out.emplace_back("no plan yet: the planner proposes scan points after the first scan");
+    return out;
+  }
+  out.push_back("plan " + plan.at("id").dump() + " after scan " + plan.at("based_on_scan").dump() +
+                " (robot " + plan.at("robot").get<std::string>() + ", policy " +
+                plan.at("policy").get<std::string>() + ", alpha " +
+                fixed(plan.at("alpha").get<double>(), 2) + ", planned in " +
+                fixed(plan.at("plan_ms").get<double>(), 0) + " ms)");
+  const nlohmann::json& list = answer.at("candidates");
+  if (list.empty()) {
+    out.emplace_back("no candidates: the planner found no reachable point that sees anything new");
+    return out;
+  }
+  char line[256];
+  std::snprintf(line, sizeof line, "%4s %6s  %-10s %8s %8s %9s %10s %10s %9s", "rank", "id",
+                "state", "x m", "y m", "F", "gain U m2", "gain M m2", "travel m");
+  out.emplace_back(line);
+  for (const nlohmann::json& c : list) {
+    std::snprintf(
+        line, sizeof line, "%4d %6s  %-10s %8s %8s %9s %10s %10s %9s", c.at("rank").get<int>(),
+        c.at("id").dump().c_str(), c.at("state").get<std::string>().c_str(),
+        fixed(c.at("x").get<double>(), 1).c_str(), fixed(c.at("y").get<double>(), 1).c_str(),
+        fixed(c.at("f").get<double>(), 1).c_str(),
+        fixed(c.at("gain_unscanned_m2").get<double>(), 1).c_str(),
+        fixed(c.at("gain_low_res_m2").get<double>(), 1).c_str(),
+        fixed(c.at("travel_m").get<double>(), 1).c_str());
+    std::string row = line;
+    const std::string note = c.value("note", "");
+    if (!note.empty()) row += "  (" + note + ")";
+    out.push_back(row);
+  }
+  return out;
+}
+
+std::string describe_candidate(const nlohmann::json& c) {
+  return std::to_string(c.at("rank").get<int>()) + ". candidate " + c.at("id").dump() + " at " +
+         position(c.at("x").get<double>(), c.at("y").get<double>()) + ": F " +
+         fixed(c.at("f").get<double>(), 1) + ", gains U " +
+         fixed(c.at("gain_unscanned_m2").get<double>(), 1) + " + M " +
+         fixed(c.at("gain_low_res_m2").get<double>(), 1) + " m2, travel " +
+         fixed(c.at("travel_m").get<double>(), 1) + " m, " + c.at("state").get<std::string>();
+}
+
+}  // namespace scanplan::cli

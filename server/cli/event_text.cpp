@@ -1,0 +1,165 @@
+#include "event_text.hpp"
+
+#include "text_format.hpp"
+
+namespace scanplan::cli {
+namespace {
+
+using nlohmann::json;
+
+std::string str(const json& e, const char* key) {
+  const auto it = e.find(key);
+  if (it == e.end() || it->is_null()) return "";
+  return it->is_string() ? it->get<std::string>() : it->dump();
+}
+
+double num(const json& e, const char* key) {
+  const auto it = e.find(key);
+  return it != e.end() && it->is_number() ? it->get<double>() : 0.0;
+}
+
+std::string with_message(std::string text, const json& e) {
+  if (const std::string m = str(e, "message"); !m.empty()) text += ": " + m;
+  return text;
+}
+
+std::string by(const json& e) {
+  const std::string who = str(e, "by");
+  return who.empty() ? "" : " by " + who;
+}
+
+std::string scan_progress(const json& e) {
+  const std::string state = str(e, "state");
+  std::string text = str(e, "robot") + " scan command " + str(e, "command_id") + " ";
+  if (state == "failed") {
+    return with_message(text + "FAILED at " + fixed(100 * num(e, "fraction"), 0) + "%", e);
+  }
+  return with_message(text + progress_bar(num(e, "fraction")) + " " + state, e);
+}
+
+std::string match_done(const json& e) {
+  std::string text = "scan " + str(e, "scan") + ": " + str(e, "method") + " " +
+                     (e.value("converged", false) ? "converged" : "did not converge") + ", score " +
+                     fixed(num(e, "score"), 1) + ", rmse " + fixed(num(e, "rmse"), 3) + " m";
+  const bool applied = e.value("applied", false);
+  // A match that was not applied leaves the estimate as it was; its correction says nothing.
+  if (const auto c = e.find("correction"); applied && c != e.end() && c->is_object()) {
+    text += ", correction dx " + signed_fixed(num(*c, "x"), 2) + " dy " +
+            signed_fixed(num(*c, "y"), 2) + " dz " + signed_fixed(num(*c, "z"), 2) + " m dyaw " +
+            signed_fixed(num(*c, "yaw_deg"), 1) + " deg";
+  }
+  text += applied ? " (applied)" : " (NOT applied: the robot's estimate is kept)";
+  text += ", " + fixed(num(e, "time_ms"), 0) + " ms";
+  return with_message(text, e);
+}
+
+std::string mission(const json& e) {
+  const std::string kind = str(e, "kind");
+  const std::string candidate = "candidate " + str(e, "candidate");
+  if (kind == "approve") {
+    return "approved " + candidate + by(e) + ": " + str(e, "robot") + " drives to " +
+           position(num(e, "x"), num(e, "y")) + " heading " + fixed(num(e, "yaw_deg"), 0) +
+           " deg (command " + str(e, "command_id") + ")";
+  }
+  if (kind == "reject") {
+    const std::string reason = str(e, "reason");
+    return "rejected " + candidate + by(e) + (reason.empty() ? "" : " (" + reason + ")");
+  }
+  if (kind == "cancel") return "cancelled " + candidate + by(e) + ": " + str(e, "robot") + " stops";
+  if (kind == "arrived") {
+    return with_message(str(e, "robot") + " arrived at " + candidate + "; a scan follows", e);
+  }
+  if (kind == "refused") {
+    return with_message(str(e, "robot") + " refused to drive to " + candidate, e);
+  }
+  if (kind == "scan_requested") {
+    const std::string after = str(e, "after");
+    return "scan requested from " + str(e, "robot") + " (command " + str(e, "command_id") + ")" +
+           (after.empty() ? "" : " after " + after);
+  }
+  json rest = e;
+  rest.erase("type");
+  rest.erase("at");
+  return rest.dump();
+}
+
+}  // namespace
+
+std::optional<MapChunk> parse_map_chunk(std::string_view frame) {
+  if (frame.size() < 13) return std::nullopt;
+  const auto byte = [&](std::size_t i) {
+    return static_cast<std::uint64_t>(static_cast<unsigned char>(frame[i]));
+  };
+  MapChunk c;
+  c.op = static_cast<std::uint8_t>(byte(0));
+  for (int k = 0; k < 4; ++k) c.id |= static_cast<std::uint32_t>(byte(1 + k) << (8 * k));
+  for (int k = 0; k < 8; ++k) c.sent_ns |= byte(5 + k) << (8 * k);
+  c.payload_bytes = frame.size() - 13;
+  return c;
+}
+
+std::string describe_event(const json& e) {
+  const std::string type = str(e, "type");
+  if (type == "scan_progress") return scan_progress(e);
+  if (type == "robot_status") {
+    std::string text = str(e, "robot") + " " + str(e, "state");
+    if (str(e, "command_id") != "0") text += " (command " + str(e, "command_id") + ")";
+    if (const auto p = e.find("pose"); p != e.end() && p->is_object()) {
+      text += " at " + position(num(*p, "x"), num(*p, "y")) + " heading " +
+              fixed(num(*p, "yaw_deg"), 0) + " deg";
+    }
+    return with_message(text, e);
+  }
+  if (type == "scan_received") {
+    return "scan " + str(e, "scan") + " from " + str(e, "robot") + " stored: " + str(e, "points") +
+           " points";
+  }
+  if (type == "match_done") return match_done(e);
+  if (type == "map_updated") {
+    return "scan " + str(e, "scan") + " is in the map: completed " +
+           fixed(num(e, "completed_m2"), 0) + " m2, low-res " +
+           fixed(num(e, "low_resolution_m2"), 0) + " m2, unscanned " +
+           fixed(num(e, "unscanned_m2"), 0) + " m2, movable " + fixed(num(e, "movable_m2"), 0) +
+           " m2";
+  }
+  if (type == "plan_done") {
+    return "plan " + str(e, "plan") + " after scan " + str(e, "based_on_scan") + ": " +
+           str(e, "candidates") + " candidates in " + fixed(num(e, "plan_ms"), 0) + " ms";
+  }
+  if (type == "mission") return mission(e);
+  if (type == "annotation") {
+    std::string text = str(e, "kind") + " #" + str(e, "id") + " at " +
+                       position(num(e, "x"), num(e, "y")) + ", z " + fixed(num(e, "z"), 1) +
+                       " by " + str(e, "author");
+    if (const std::string t = str(e, "text"); !t.empty()) text += ": " + t;
+    return text;
+  }
+  if (type == "annotation_deleted") return "#" + str(e, "id") + " deleted" + by(e);
+  if (type == "binary_dropped") {
+    return str(e, "count") + " map chunks (scans " + str(e, "first_id") + ".." + str(e, "last_id") +
+           ") dropped: this link is too slow for them";
+  }
+  json rest = e;
+  rest.erase("type");
+  rest.erase("at");
+  return rest.dump();
+}
+
+std::string describe_map_chunk(const MapChunk& c) {
+  if (c.op != 1) {
+    return "binary frame op " + std::to_string(c.op) + ", id " + std::to_string(c.id) + ": " +
+           std::to_string(c.payload_bytes) + " bytes (not shown)";
+  }
+  return "scan " + std::to_string(c.id) + ": " + std::to_string(c.payload_bytes) +
+         " bytes of Draco points (not shown)";
+}
+
+json map_chunk_json(const MapChunk& c) {
+  return {{"type", "map_chunk"},
+          {"op", c.op},
+          {"scan", c.id},
+          {"bytes", c.payload_bytes},
+          {"sent_ns", c.sent_ns}};
+}
+
+}  // namespace scanplan::cli
