@@ -50,10 +50,9 @@ struct PlannerConfig {
   // removes is the long drive across the site to a scan hardly better than one nearby. A metre
   // beyond that costs a fixed share of what the best scan would gain, so the trade keeps its
   // balance as the gains shrink over a mission (an absolute cost in m²/m that suits the first
-  // scans pins the robot to crumbs near the end). Chosen on the campus, 5 seeds to 95%
-  // coverage (docs/benchmarks.md): a cost from the first metre (free 0) drove 0.64× the path
-  // of `paper` for 1.2 scans more; with the first 80 m free and 0.005 beyond, 10 seeds took
-  // as many scans as `paper` (37.5 vs 37.4) on 0.68× its path.
+  // scans pins the robot to crumbs near the end). Chosen on the campus, 10 seeds to 95%
+  // coverage (docs/benchmarks.md): as many scans as `paper` (37.4) on 0.67× its path; a cost
+  // from the first metre (free 0) saved a little more path for about half a scan more.
   double travel_cost_per_m = 0.005;
   double travel_free_m = 80.0;
   // Candidates in the ranked list lie at least this far apart, so that the operator chooses
