@@ -8,7 +8,7 @@
 // for the whole map's new encoding (GET map.drc), as a robot's one-minute scan would. Prints one JSON line. Run with
 // tests/bench/server_bench.sh.
 import { execFileSync } from 'node:child_process';
-import { readFileSync, mkdtempSync, rmSync } from 'node:fs';
+import { readFileSync, mkdtempSync, mkdirSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { createRequire } from 'node:module';
@@ -22,7 +22,11 @@ const world = join(src, 'samples/worlds/campus.json');
 const work = mkdtempSync(join(tmpdir(), 'scanplan-bench-'));
 
 // Where the planner sends the robot: the true poses of a closed-loop run.
-execFileSync(cli, ['simulate', '--world', world, '--policy', 'paper', '--max-scans', String(scans),
+// Exact poses there, so that the loop runs to SCANS scans rather than stopping where a map built
+// from noisy, unmatched poses leaves nothing movable.
+mkdirSync(join(work, 'exact'));
+const exact = worldVariant(join(work, 'exact'), 'campus.json', { pose_noise: { xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 } }).file;
+execFileSync(cli, ['simulate', '--world', exact, '--policy', 'paper', '--max-scans', String(scans),
   '--match', 'off', '--seed', '1', '--out', join(work, 'sim')], { stdio: ['ignore', 'ignore', 'ignore'] });
 const poses = JSON.parse(readFileSync(join(work, 'sim', 'summary.json'), 'utf8')).true_poses;
 // The scans themselves with a finer stage step (0.27° instead of 0.5°): 260k points and more
