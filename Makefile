@@ -2,6 +2,7 @@
 BUILD ?= build
 JOBS ?= 2
 PORT ?= 8080
+ROBOTS ?= 1
 WEB_SOURCES := $(wildcard web/src/*) web/index.html web/build.mjs web/package.json
 
 .PHONY: all deps web build test demo format clean
@@ -29,7 +30,7 @@ test: build
 	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
 
 demo: build
-	scripts/demo.sh $(BUILD) $(PORT)
+	ROBOTS=$(ROBOTS) scripts/demo.sh $(BUILD) $(PORT)
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')

@@ -4,10 +4,15 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <csignal>
+#include <vector>
 
 #include "replay_robot.hpp"
+#include "scanplan/core/ray_caster.hpp"
+#include "scanplan/core/world_traversability.hpp"
 #include "scanplan/msgs/dds_participant.hpp"
 #include "simulated_robot.hpp"
 
@@ -15,6 +20,16 @@ namespace {
 std::atomic<bool> g_stop{false};
 void on_signal(int) {
   g_stop = true;
+}
+// Whether a robot placed at the world's start stands on ground the bridge can drive from.
+bool can_stand_at_start(const scanplan::World& world) {
+  const scanplan::RayCaster caster(world);
+  const scanplan::WorldTraversability ground(world, caster);
+  const auto cell = ground.cell_of(world.start.x, world.start.y);
+  if (!cell) return false;
+  const auto& surfaces = ground.surfaces(*cell);
+  return std::any_of(surfaces.begin(), surfaces.end(),
+                     [&](float z) { return std::abs(z - world.start.z) < 0.3; });
 }
 }  // namespace
 
@@ -34,6 +49,13 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   app.add_option("--seed", options.seed, "seed for range and pose noise")->capture_default_str();
+  std::vector<double> start;
+  auto* start_opt = app.add_option("--start", start,
+                                   "x,y,yaw_deg: where the simulated robot starts (default: the "
+                                   "world's start; several robots need one each)")
+                        ->expected(3)
+                        ->delimiter(',');
+  start_opt->needs(world_opt);
   CLI11_PARSE(app, argc, argv);
   spdlog::set_default_logger(spdlog::stderr_color_mt("bridge"));
   if (world_file.empty() == replay_dir.empty()) {
@@ -46,8 +68,21 @@ int main(int argc, char** argv) {
   try {
     scanplan::dds::Participant participant(domain);
     if (!world_file.empty()) {
-      scanplan::bridge::SimulatedRobot robot(scanplan::load_world(world_file), participant,
-                                             options);
+      scanplan::World world = scanplan::load_world(world_file);
+      if (!start.empty()) {
+        world.start.x = start[0];
+        world.start.y = start[1];
+        world.start.z = world.ground_height(start[0], start[1]);
+        world.start.yaw = scanplan::deg2rad(start[2]);
+        if (!can_stand_at_start(world)) {
+          spdlog::error(
+              "--start {},{}: no ground a robot can stand on there in world '{}' (inside an "
+              "obstacle, or outside the target region)",
+              start[0], start[1], world.name);
+          return 2;
+        }
+      }
+      scanplan::bridge::SimulatedRobot robot(std::move(world), participant, options);
       robot.run(g_stop);
     } else {
       scanplan::bridge::ReplayOptions replay{options.robot_id, options.time_scale};

@@ -9,6 +9,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "scanplan/core/scan_claims.hpp"
 #include "scanplan/core/scan_gain.hpp"
 #include "scanplan/core/travel_map.hpp"
 
@@ -63,6 +64,7 @@ void check_config(const PlannerConfig& c) {
   if (!(c.travel_cost_per_m >= 0)) fail("travel_cost_per_m must be zero or more");
   if (!(c.travel_free_m >= 0)) fail("travel_free_m must be zero or more");
   if (!(c.candidate_separation_m >= 0)) fail("candidate_separation_m must be zero or more");
+  if (!(c.claim_separation_m >= 0)) fail("claim_separation_m must be zero or more");
   if (!std::isfinite(c.min_gain_m2)) fail("min_gain_m2 must be finite");
   if (c.threads < 0) fail("threads must be zero (OpenMP default) or more");
 }
@@ -109,8 +111,21 @@ struct Sites {
   }
 };
 
+// The other robots' claimed scan points, checked: each must be finite.
+const std::vector<Eigen::Vector3d>& claims_of(const PlanInput& in) {
+  static const std::vector<Eigen::Vector3d> kNone;
+  if (!in.claimed) return kNone;
+  for (const Eigen::Vector3d& c : *in.claimed) {
+    if (!c.allFinite())
+      throw std::invalid_argument("plan_next_scan: a claimed point is not finite");
+  }
+  return *in.claimed;
+}
+
 Sites collect_sites(const MlsMap& map, const MovableRegion& movable, const TravelMap& travel,
-                    const TargetRegion* within) {
+                    const TargetRegion* within, const std::vector<Eigen::Vector3d>& claims,
+                    double claim_separation_m) {
+  const double claim_sep2 = claim_separation_m * claim_separation_m;
   Sites s;
   const auto& g = movable.patch;
   s.index = CellGrid<std::int32_t>(g.origin, g.cols, g.rows, g.cell_m, -1);
@@ -122,6 +137,12 @@ Sites collect_sites(const MlsMap& map, const MovableRegion& movable, const Trave
     // The robot may start outside the target region, but it scans only inside.
     const Eigen::Vector2d centre = map.center_of(c);
     if (within && !within->contains(centre.x(), centre.y())) continue;
+    // Another robot is going there.
+    if (std::any_of(claims.begin(), claims.end(), [&](const Eigen::Vector3d& c) {
+          return (c.head<2>() - centre).squaredNorm() < claim_sep2;
+        })) {
+      continue;
+    }
     s.index.values[o] = static_cast<std::int32_t>(s.cell.size());
     s.cell.push_back(c);
     // The robot stands on the floor's surface: its mean height, the measured ground.
@@ -415,6 +436,7 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
   check_config(cfg);
   if (!in.robot.allFinite())
     throw std::invalid_argument("plan_next_scan: the robot position is not finite");
+  const std::vector<Eigen::Vector3d>& claims = claims_of(in);
   const auto t0 = std::chrono::steady_clock::now();
   Plan plan;
   const auto finish = [&]() -> Plan {
@@ -441,9 +463,17 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
   const TravelMap travel = travel_map(in.map, plan.movable, start, cfg.movable,
                                       cfg.stay_in_target ? &in.target : nullptr);
   const Sites sites =
-      collect_sites(in.map, plan.movable, travel, cfg.stay_in_target ? &in.target : nullptr);
+      collect_sites(in.map, plan.movable, travel, cfg.stay_in_target ? &in.target : nullptr, claims,
+                    cfg.claim_separation_m);
   if (sites.size() == 0) return finish();
-  const ScanGainEvaluator gain(in.map, plan.regions, cfg.alpha, cfg.regions, cfg.visibility);
+  // With claims, F is taken against the segmentation as it will be after the other robots'
+  // scans; plan.regions stays the map's own.
+  RegionMap claimed_regions;
+  if (!claims.empty()) claimed_regions = plan.regions;
+  const ScanGainEvaluator gain(in.map, claims.empty() ? plan.regions : claimed_regions, cfg.alpha,
+                               cfg.regions, cfg.visibility);
+  if (!claims.empty())
+    claim_predicted_scans(claimed_regions, gain.predictor(), claims, cfg.regions);
   const double cell_m = in.map.cell_m();
   const int threads = thread_count(cfg);
 
@@ -525,8 +555,10 @@ double evaluate(const PlanInput& in, const PlannerConfig& cfg, const Eigen::Vect
                 Candidate* detail) {
   check_config(cfg);
   if (!b.allFinite()) throw std::invalid_argument("evaluate: the scan point is not finite");
-  const RegionMap regions = segment_regions(in.map, in.target, in.scan_points, cfg.regions);
+  const std::vector<Eigen::Vector3d>& claims = claims_of(in);
+  RegionMap regions = segment_regions(in.map, in.target, in.scan_points, cfg.regions);
   const ScanGainEvaluator gain(in.map, regions, cfg.alpha, cfg.regions, cfg.visibility);
+  if (!claims.empty()) claim_predicted_scans(regions, gain.predictor(), claims, cfg.regions);
   const CellIndex c = in.map.index_of(b.x(), b.y());
   const ScanGain g = gain.at(c, b.z());
   if (detail) {

@@ -13,20 +13,32 @@ std::vector<std::string> render_candidate_table(const nlohmann::json& answer) {
     out.emplace_back("no plan yet: the planner proposes scan points after the first scan");
     return out;
   }
-  out.push_back("plan " + plan.at("id").dump() + " after scan " + plan.at("based_on_scan").dump() +
-                " (robot " + plan.at("robot").get<std::string>() + ", policy " +
-                plan.at("policy").get<std::string>() + ", alpha " +
-                fixed(plan.at("alpha").get<double>(), 2) + ", planned in " +
-                fixed(plan.at("plan_ms").get<double>(), 0) + " ms)");
+  // Several robots: one plan each (the newest first), and a robot column in the table.
+  const nlohmann::json plans =
+      answer.contains("plans") ? answer.at("plans") : nlohmann::json::array({plan});
+  const bool several = plans.size() > 1;
+  for (const nlohmann::json& p : plans) {
+    out.push_back("plan " + p.at("id").dump() + " after scan " + p.at("based_on_scan").dump() +
+                  " (robot " + p.at("robot").get<std::string>() + ", policy " +
+                  p.at("policy").get<std::string>() + ", alpha " +
+                  fixed(p.at("alpha").get<double>(), 2) + ", planned in " +
+                  fixed(p.at("plan_ms").get<double>(), 0) + " ms)");
+  }
   const nlohmann::json& list = answer.at("candidates");
   if (list.empty()) {
     out.emplace_back("no candidates: the planner found no reachable point that sees anything new");
     return out;
   }
   char line[256];
+  const auto robot_column = [&](const std::string& robot) {
+    if (!several) return std::string();
+    char cell[32];
+    std::snprintf(cell, sizeof cell, "%-10.10s ", robot.c_str());
+    return std::string(cell);
+  };
   std::snprintf(line, sizeof line, "%4s %6s  %-10s %8s %8s %9s %10s %10s %9s", "rank", "id",
                 "state", "x m", "y m", "F", "gain U m2", "gain M m2", "travel m");
-  out.emplace_back(line);
+  out.push_back(robot_column("robot") + line);
   for (const nlohmann::json& c : list) {
     std::snprintf(
         line, sizeof line, "%4d %6s  %-10s %8s %8s %9s %10s %10s %9s", c.at("rank").get<int>(),
@@ -36,7 +48,7 @@ std::vector<std::string> render_candidate_table(const nlohmann::json& answer) {
         fixed(c.at("gain_unscanned_m2").get<double>(), 1).c_str(),
         fixed(c.at("gain_low_res_m2").get<double>(), 1).c_str(),
         fixed(c.at("travel_m").get<double>(), 1).c_str());
-    std::string row = line;
+    std::string row = robot_column(c.value("robot", "")) + line;
     const std::string note = c.value("note", "");
     if (!note.empty()) row += "  (" + note + ")";
     out.push_back(row);

@@ -42,11 +42,13 @@ json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas) {
           {"areas", areas ? areas_json(*areas) : json(nullptr)}};
 }
 
-json candidate_json(const CandidateRecord& r) {
+json candidate_json(const CandidateRecord& r, const std::string& robot, std::uint64_t plan) {
   const Candidate& c = r.candidate;
   json path = json::array();
   for (const auto& p : c.path) path.push_back({p.x(), p.y()});
   return {{"id", r.id},
+          {"robot", robot},
+          {"plan", plan},
           {"rank", r.rank},
           {"state", r.state},
           {"note", r.note},
@@ -153,7 +155,7 @@ void Api::install(http::Router& router) {
   });
   router.add("GET", "/api/v1/candidates", [this](const Request& r, const auto&) {
     require(r, Role::kViewer);
-    return candidates();
+    return candidates(r);
   });
   for (const std::string action : {"approve", "reject", "cancel"}) {
     router.add("POST", "/api/v1/candidates/{id}/" + action,
@@ -352,18 +354,35 @@ Response Api::get_scan(const std::string& id) const {
   throw HttpError(404, "not_found", "no scan " + id + " in this session");
 }
 
-Response Api::candidates() const {
-  const auto plan = store_.plan();
-  json list = json::array();
-  if (!plan) return Response::json(200, {{"plan", nullptr}, {"candidates", list}});
-  for (const CandidateRecord& r : plan->candidates) list.push_back(candidate_json(r));
-  return Response::json(200, {{"plan",
-                               {{"id", plan->id},
-                                {"based_on_scan", plan->based_on_scan},
-                                {"robot", plan->robot},
-                                {"policy", plan->policy},
-                                {"alpha", plan->alpha},
-                                {"plan_ms", plan->plan_ms}}},
+Response Api::candidates(const Request& request) const {
+  const auto header = [](const PlanRecord& p) -> json {
+    return {{"id", p.id},
+            {"based_on_scan", p.based_on_scan},
+            {"robot", p.robot},
+            {"policy", p.policy},
+            {"alpha", p.alpha},
+            {"plan_ms", p.plan_ms},
+            {"candidates", p.candidates.size()}};
+  };
+  // One plan per robot; the newest (the robot whose scan came last) first.
+  std::vector<PlanRecord> plans;
+  const auto robot = request.query.find("robot");
+  if (robot != request.query.end()) {
+    if (auto p = store_.plan(robot->second)) plans.push_back(std::move(*p));
+  } else {
+    plans = store_.plans();
+    if (const auto latest = store_.plan()) {
+      std::stable_partition(plans.begin(), plans.end(),
+                            [&](const PlanRecord& p) { return p.robot == latest->robot; });
+    }
+  }
+  json list = json::array(), headers = json::array();
+  for (const PlanRecord& p : plans) {
+    headers.push_back(header(p));
+    for (const CandidateRecord& r : p.candidates) list.push_back(candidate_json(r, p.robot, p.id));
+  }
+  return Response::json(200, {{"plan", plans.empty() ? json(nullptr) : header(plans.front())},
+                              {"plans", headers},
                               {"candidates", list}});
 }
 
@@ -477,7 +496,12 @@ Response Api::post_goal(const Request& request) {
   }
   try {
     const CandidateRecord c = mission_.propose(x, y, robot, decided_by(body));
-    return Response::json(201, candidate_json(c));
+    for (const PlanRecord& p : store_.plans()) {
+      for (const CandidateRecord& k : p.candidates) {
+        if (k.id == c.id) return Response::json(201, candidate_json(c, p.robot, p.id));
+      }
+    }
+    return Response::json(201, candidate_json(c, robot, 0));
   } catch (const MissionError& e) {
     throw HttpError(e.status, e.code, e.what());
   }

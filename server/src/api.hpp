@@ -32,7 +32,7 @@ class Api {
   http::Response post_scan(const http::Request& request);
   http::Response list_scans() const;
   http::Response get_scan(const std::string& id) const;
-  http::Response candidates() const;
+  http::Response candidates(const http::Request& request) const;
   http::Response get_params() const;
   http::Response put_params(const http::Request& request);
   http::Response post_goal(const http::Request& request);

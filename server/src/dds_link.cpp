@@ -195,6 +195,32 @@ void DdsLink::publish_map(const PointCloud& map_points) {
   }
 }
 
+DdsLink::RobotWriters DdsLink::robot_writers(const std::string& robot) {
+  std::lock_guard lock(robot_writers_mutex_);
+  if (const auto it = robot_writers_.find(robot); it != robot_writers_.end()) return it->second;
+  RobotWriters w;
+  const auto candidates = topics::robot_topic(robot, topics::kRobotCandidatesSuffix);
+  const auto goal = topics::robot_topic(robot, topics::kRobotGoalSuffix);
+  if (candidates && goal) {
+    try {
+      w.candidates = participant_.writer(geometry_msgs_msg_dds__PoseArray__desc, *candidates,
+                                         dds::QosKind::kLatched);
+      w.goal = participant_.writer(geometry_msgs_msg_dds__PoseStamped__desc, *goal,
+                                   dds::QosKind::kLatched);
+    } catch (const std::exception& e) {
+      spdlog::error("robot '{}' gets no topics of its own: {}", robot, e.what());
+      w = {};
+    }
+  } else {
+    spdlog::warn(
+        "robot id '{}' cannot name a ROS 2 namespace (a letter, then letters, digits, '_'): its "
+        "plan and goal go out on the shared topics only",
+        robot);
+  }
+  robot_writers_[robot] = w;
+  return w;
+}
+
 void DdsLink::publish_candidates(const PlanRecord& plan) {
   try {
     std::vector<Pose> poses;
@@ -210,17 +236,23 @@ void DdsLink::publish_candidates(const PlanRecord& plan) {
     dds::to_pose_array(poses, topics::kMapFrame, now_ns(), msg);
     dds::check(dds_write(candidates_writer_, &msg.msg),
                "publishing the candidates on " + std::string(topics::kCandidates));
+    if (const dds_entity_t own = robot_writers(plan.robot).candidates) {
+      dds::check(dds_write(own, &msg.msg), "publishing robot '" + plan.robot + "'s candidates");
+    }
   } catch (const std::exception& e) {
     spdlog::error("the candidates of plan {} were not published: {}", plan.id, e.what());
   }
 }
 
-void DdsLink::publish_goal(const Pose& goal) {
+void DdsLink::publish_goal(const std::string& robot, const Pose& goal) {
   try {
     dds::OwnedPoseStamped msg;
     dds::to_pose_stamped(goal, topics::kMapFrame, now_ns(), msg);
     dds::check(dds_write(goal_writer_, &msg.msg),
                "publishing the goal on " + std::string(topics::kGoal));
+    if (const dds_entity_t own = robot_writers(robot).goal) {
+      dds::check(dds_write(own, &msg.msg), "publishing robot '" + robot + "'s goal");
+    }
   } catch (const std::exception& e) {
     spdlog::error("the goal ({:.2f}, {:.2f}) was not published: {}", goal.x, goal.y, e.what());
   }

@@ -72,10 +72,13 @@ class DdsLink {
   //
   // The thinned map in the map frame (PointCloud2, x y z float32 + rgb).
   void publish_map(const PointCloud& map_points);
-  // The plan's candidates, best first, each facing the way the robot would arrive (PoseArray).
+  // The plan's candidates, best first, each facing the way the robot would arrive (PoseArray),
+  // on rt/scanplan/candidates (the newest plan, whichever robot it is for) and on the robot's
+  // own rt/<robot>/scanplan/candidates.
   void publish_candidates(const PlanRecord& plan);
-  // Where the operator sent a robot (PoseStamped).
-  void publish_goal(const Pose& goal);
+  // Where the operator sent `robot` (PoseStamped), on rt/scanplan/goal and
+  // rt/<robot>/scanplan/goal.
+  void publish_goal(const std::string& robot, const Pose& goal);
   void publish_annotation(const Annotation& annotation);
   // Disposes and unregisters a deleted annotation, so late joiners no longer get it.
   void withdraw_annotation(std::int64_t id);
@@ -127,6 +130,11 @@ class DdsLink {
   bool from_lost_bridge(const dds_sample_info_t& info) const;
   // The parts of scan `key`, or null for a scan discarded with its bridge.
   PartialScan* part(const Key& key);
+  // One robot's own latched topics (docs/dds.md "Several robots"), made on first use.
+  struct RobotWriters {
+    dds_entity_t candidates = 0, goal = 0;  // 0 where the id cannot name a topic
+  };
+  RobotWriters robot_writers(const std::string& robot);
   // Throws NoScannerError when `robot_id`'s bridge is lost.
   void require_connected(const std::string& robot_id) const;
 
@@ -157,6 +165,8 @@ class DdsLink {
   std::deque<Key> discarded_;           // scans dropped with their bridge; DDS thread only
   mutable std::mutex awaited_mutex_;
   std::map<std::string, AwaitedScan> awaited_;  // by robot, under awaited_mutex_
+  std::mutex robot_writers_mutex_;
+  std::map<std::string, RobotWriters> robot_writers_;  // under robot_writers_mutex_
 };
 
 }  // namespace scanplan::server

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <cstdio>
 
 namespace scanplan::server {
 
@@ -31,11 +32,10 @@ void Mission::record_event(const std::string& type, const json& details) {
 }
 
 CandidateRecord Mission::find(std::uint64_t id, std::string* robot) const {
-  const auto plan = store_.plan();
-  if (plan) {
-    for (const auto& c : plan->candidates) {
+  for (const PlanRecord& plan : store_.plans()) {
+    for (const auto& c : plan.candidates) {
       if (c.id == id) {
-        if (robot) *robot = plan->robot;
+        if (robot) *robot = plan.robot;
         return c;
       }
     }
@@ -58,6 +58,27 @@ json Mission::approve(std::uint64_t id, const std::string& by) {
     throw MissionError(409, "conflict",
                        "robot '" + robot + "' is still carrying out an approved move");
   }
+  // Two robots are never sent to the same spot: the planner keeps each robot's candidates
+  // away from the others' goals, and a choice made by hand is held to the same distance.
+  const double keep_apart_m = store_.claim_separation_m();
+  for (const auto& [other, move] : moving_) {
+    CandidateRecord goal;
+    try {
+      goal = find(move.candidate, nullptr);
+    } catch (const MissionError&) {
+      continue;  // its plan is gone: the robot has scanned since
+    }
+    const double d = (goal.candidate.position - c.candidate.position).head<2>().norm();
+    if (d < keep_apart_m) {
+      char why[160];
+      std::snprintf(why, sizeof why,
+                    "robot '%s' is already going to (%.1f, %.1f), %.1f m from there", other.c_str(),
+                    goal.candidate.position.x(), goal.candidate.position.y(), d);
+      throw MissionError(409, "conflict",
+                         std::string(why) + ": choose a point at least " +
+                             std::to_string(static_cast<int>(keep_apart_m)) + " m away");
+    }
+  }
   const double yaw_deg = approach_yaw_deg(c.candidate);
   std::uint32_t command = 0;
   try {
@@ -72,7 +93,7 @@ json Mission::approve(std::uint64_t id, const std::string& by) {
   goal.y = c.candidate.position.y();
   goal.z = c.candidate.position.z();
   goal.yaw = deg2rad(yaw_deg);
-  dds_.publish_goal(goal);
+  dds_.publish_goal(robot, goal);
   const json out = {{"candidate", id},
                     {"robot", robot},
                     {"command_id", command},
@@ -117,7 +138,7 @@ json Mission::cancel(std::uint64_t id, const std::string& by) {
   moving_.erase(it);
   store_.set_candidate_state(id, "cancelled");
   // The robot's goal is now where it stands; the old one must not linger on the latched topic.
-  if (rs != states.end()) dds_.publish_goal(here);
+  if (rs != states.end()) dds_.publish_goal(robot, here);
   const json out = {{"candidate", id}, {"robot", robot}, {"by", by}};
   record("cancel", out);
   return out;
@@ -127,15 +148,16 @@ CandidateRecord Mission::propose(double x, double y, const std::string& robot,
                                  const std::string& by) {
   // Not under mutex_: add_goal may wait for a scan being brought into the map, and the DDS
   // thread's on_status must not wait that long.
-  const auto plan = store_.plan();
-  if (!plan) throw MissionError(409, "no_map", "there is no map yet: take a first scan");
-  if (!robot.empty() && robot != plan->robot) {
-    throw MissionError(400, "bad_request",
-                       "the current plan is for robot '" + plan->robot + "', not '" + robot + "'");
+  const auto plan = store_.plan(robot);
+  if (!plan) {
+    if (store_.plans().empty())
+      throw MissionError(409, "no_map", "there is no map yet: take a first scan");
+    throw MissionError(400, "unknown_robot",
+                       "robot '" + robot + "' has no plan: it has not sent a scan yet");
   }
   CandidateRecord c;
   try {
-    c = store_.add_goal(x, y);
+    c = store_.add_goal(x, y, plan->robot);
   } catch (const GoalRefused& e) {
     throw MissionError(e.code == "no_map" ? 409 : 400, e.code, e.what());
   }

@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace scanplan::server {
@@ -69,19 +70,20 @@ StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
       scan.estimated, *matching_);
   const Pose& e = scan.estimated;
   const Pose& p = m.placed;
-  events_.publish("match_done", {{"scan", scan.id},
-                                 {"method", m.result.method},
-                                 {"converged", m.result.converged},
-                                 {"applied", m.applied},
-                                 {"score", m.result.score},
-                                 {"rmse", m.result.rmse},
-                                 {"time_ms", m.result.time_ms},
-                                 {"message", m.result.message},
-                                 {"correction",
-                                  {{"x", p.x - e.x},
-                                   {"y", p.y - e.y},
-                                   {"z", p.z - e.z},
-                                   {"yaw_deg", rad2deg(std::remainder(p.yaw - e.yaw, 2 * M_PI))}}}});
+  events_.publish("match_done",
+                  {{"scan", scan.id},
+                   {"method", m.result.method},
+                   {"converged", m.result.converged},
+                   {"applied", m.applied},
+                   {"score", m.result.score},
+                   {"rmse", m.result.rmse},
+                   {"time_ms", m.result.time_ms},
+                   {"message", m.result.message},
+                   {"correction",
+                    {{"x", p.x - e.x},
+                     {"y", p.y - e.y},
+                     {"z", p.z - e.z},
+                     {"yaw_deg", rad2deg(std::remainder(p.yaw - e.yaw, 2 * M_PI))}}}});
   if (!m.applied) {
     spdlog::warn("scan {} stays at its reported pose: {}", scan.id, m.result.message);
     return scan;
@@ -104,11 +106,17 @@ void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud) {
                                   {"low_resolution_m2", a.low_resolution_m2},
                                   {"unscanned_m2", a.unscanned_m2},
                                   {"movable_m2", a.movable_m2}});
-  if (const auto plan = live_.plan()) {
-    events_.publish("plan_done", {{"plan", plan->id},
-                                  {"based_on_scan", plan->based_on_scan},
-                                  {"candidates", plan->candidates.size()},
-                                  {"plan_ms", plan->plan_ms}});
+  // One plan per robot that is not driving; the scanning robot's first.
+  std::vector<PlanRecord> plans = live_.plans();
+  std::stable_partition(plans.begin(), plans.end(),
+                        [&](const PlanRecord& p) { return p.robot == scan.robot; });
+  for (const PlanRecord& plan : plans) {
+    if (plan.based_on_scan != scan.id) continue;
+    events_.publish("plan_done", {{"plan", plan.id},
+                                  {"robot", plan.robot},
+                                  {"based_on_scan", plan.based_on_scan},
+                                  {"candidates", plan.candidates.size()},
+                                  {"plan_ms", plan.plan_ms}});
   }
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <set>
 
 #include "scanplan/core/draco_codec.hpp"
 #include "scanplan/core/top_view.hpp"
@@ -18,7 +19,10 @@ double approach_yaw_deg(const Candidate& c) {
 }
 
 ScanStore::ScanStore(PipelineConfig pipeline, PlannerConfig planner)
-    : pipeline_(pipeline), planner_(planner), encoder_([this] { encode_loop(); }) {}
+    : pipeline_(pipeline),
+      planner_(planner),
+      claim_separation_m_(planner.claim_separation_m),
+      encoder_([this] { encode_loop(); }) {}
 
 ScanStore::~ScanStore() {
   {
@@ -87,7 +91,8 @@ void ScanStore::add(const StoredScan& scan, const PointCloud& cloud) {
   thinned_.add(*shared);
   pipeline_.add_scan(cloud, pose);
   last_scan_ = {scan.id, scan.robot};
-  const auto plan = refresh_derived([&] {
+  scan_pose_of_[scan.robot] = pose;
+  const auto plans = refresh_derived([&] {
     scans_.push_back(scan);
     chunks_[scan.id] = chunk;
     point_count_ += shared->size();
@@ -101,37 +106,99 @@ void ScanStore::add(const StoredScan& scan, const PointCloud& cloud) {
   // Outside mutex_ so readers are not held up, inside encode_mutex_ so maps and plans go out in
   // the order they were made; the map first, as the plan is made from it.
   if (on_map) on_map(thinned_.cloud());
-  if (plan && on_plan) on_plan(*plan);
+  // The plan of the robot whose scan came last goes last: it is the newest on a latched topic.
+  if (on_plan) {
+    for (auto it = plans.rbegin(); it != plans.rend(); ++it) on_plan(*it);
+  }
 }
 
-std::optional<PlanRecord> ScanStore::refresh_derived(const std::function<void()>& commit) {
+namespace {
+
+// A robot is carrying out an approved move to this candidate.
+bool is_active_goal(const CandidateRecord& c) {
+  return c.state == "moving";
+}
+
+Eigen::Vector3d floor_point(const CandidateRecord& c) {
+  return c.candidate.position;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> ScanStore::claims_except(const std::string& robot) const {
+  std::vector<Eigen::Vector3d> claims;
+  for (const auto& [id, plan] : plans_) {
+    if (id == robot) continue;
+    const CandidateRecord* goal = nullptr;
+    for (const CandidateRecord& c : plan.candidates) {
+      if (is_active_goal(c)) goal = &c;
+    }
+    if (!goal) {
+      for (const CandidateRecord& c : plan.candidates) {
+        if (c.state == "proposed" && c.rank == 1) goal = &c;
+      }
+    }
+    if (goal) claims.push_back(floor_point(*goal));
+  }
+  return claims;
+}
+
+std::vector<PlanRecord> ScanStore::refresh_derived(const std::function<void()>& commit) {
   if (!pipeline_.regions() || !pipeline_.movable()) {
     std::lock_guard lock(mutex_);
     if (commit) commit();
-    return std::nullopt;
+    return {};
   }
   const RegionMap& regions = *pipeline_.regions();
   const MovableRegion& movable = *pipeline_.movable();
-  const Pose robot = pipeline_.scan_poses().back();
   const std::vector<Eigen::Vector2d> points = pipeline_.scan_points();
-  const Plan plan = plan_next_scan(
-      {pipeline_.map(), *pipeline_.target(), points, Eigen::Vector3d(robot.x, robot.y, robot.z)},
-      planner_);
 
-  PlanRecord record;
-  record.id = next_plan_id_++;
-  record.based_on_scan = last_scan_.first;
-  record.robot = last_scan_.second;
-  for (std::size_t k = 0; k < plan.ranked.size(); ++k) {
-    CandidateRecord c;
-    c.id = next_candidate_id_++;
-    c.rank = static_cast<int>(k + 1);
-    c.candidate = plan.ranked[k];
-    record.candidates.push_back(std::move(c));
+  // Several robots share the map: they are planned one after another, each counting what the
+  // robots before it will scan as taken (PlanInput::claimed), so no two are sent to one spot.
+  // A robot driving to an approved goal keeps its plan, and its goal is claimed first. The
+  // robot whose scan came last is planned next: it is the one waiting for a decision.
+  std::vector<Eigen::Vector3d> claims;
+  std::set<std::string> driving;
+  {
+    std::lock_guard lock(mutex_);
+    for (const auto& [robot, plan] : plans_) {
+      for (const CandidateRecord& c : plan.candidates) {
+        if (!is_active_goal(c)) continue;
+        claims.push_back(floor_point(c));
+        driving.insert(robot);
+      }
+    }
   }
-  record.policy = std::string(policy_name(planner_.policy));
-  record.alpha = planner_.alpha;
-  record.plan_ms = plan.plan_ms;
+  std::vector<std::string> order;
+  if (scan_pose_of_.count(last_scan_.second)) order.push_back(last_scan_.second);
+  for (const auto& [robot, pose] : scan_pose_of_) {
+    if (robot != last_scan_.second) order.push_back(robot);
+  }
+  std::vector<PlanRecord> records;
+  for (const std::string& robot : order) {
+    if (driving.count(robot)) continue;
+    const Pose& at = scan_pose_of_.at(robot);
+    PlanInput input{pipeline_.map(), *pipeline_.target(), points, {at.x, at.y, at.z}};
+    input.claimed = &claims;
+    const Plan plan = plan_next_scan(input, planner_);
+    if (!plan.ranked.empty()) claims.push_back(plan.ranked.front().position);
+
+    PlanRecord record;
+    record.id = next_plan_id_++;
+    record.based_on_scan = last_scan_.first;
+    record.robot = robot;
+    for (std::size_t k = 0; k < plan.ranked.size(); ++k) {
+      CandidateRecord c;
+      c.id = next_candidate_id_++;
+      c.rank = static_cast<int>(k + 1);
+      c.candidate = plan.ranked[k];
+      record.candidates.push_back(std::move(c));
+    }
+    record.policy = std::string(policy_name(planner_.policy));
+    record.alpha = planner_.alpha;
+    record.plan_ms = plan.plan_ms;
+    records.push_back(std::move(record));
+  }
 
   const auto png = [](const cv::Mat& img) {
     return std::make_shared<const std::vector<std::uint8_t>>(encode_png(img));
@@ -162,31 +229,60 @@ std::optional<PlanRecord> ScanStore::refresh_derived(const std::function<void()>
     // The scan, its map and everything derived from it appear to readers together.
     std::lock_guard lock(mutex_);
     if (commit) commit();
-    if (plan_) {
-      for (auto& c : plan_->candidates) {
-        if (c.state == "proposed") c.state = "superseded";
+    for (const PlanRecord& record : records) {
+      if (const auto old = plans_.find(record.robot); old != plans_.end()) {
+        for (auto& c : old->second.candidates) {
+          if (c.state == "proposed") c.state = "superseded";
+        }
       }
+      plans_[record.robot] = record;
     }
-    plan_ = record;
+    latest_robot_ = last_scan_.second;
     layers_ = std::move(layers);
     layer_geometry_ = geometry;
     areas_ = areas;
     // A commit means a scan joined (set_params re-segments without one).
     if (commit) areas_after_[last_scan_.first] = areas;
   }
-  return record;
+  return records;
 }
 
-std::optional<PlanRecord> ScanStore::plan() const {
+std::optional<PlanRecord> ScanStore::plan(const std::string& robot) const {
   std::lock_guard lock(mutex_);
-  return plan_;
+  const auto it = plans_.find(robot.empty() ? latest_robot_ : robot);
+  if (it == plans_.end()) return std::nullopt;
+  return it->second;
 }
 
-CandidateRecord ScanStore::add_goal(double x, double y) {
+std::vector<PlanRecord> ScanStore::plans() const {
+  std::lock_guard lock(mutex_);
+  std::vector<PlanRecord> out;
+  for (const auto& [robot, plan] : plans_) out.push_back(plan);
+  return out;
+}
+
+CandidateRecord* ScanStore::find_candidate(std::uint64_t id) {
+  for (auto& [robot, plan] : plans_) {
+    for (auto& c : plan.candidates) {
+      if (c.id == id) return &c;
+    }
+  }
+  return nullptr;
+}
+
+CandidateRecord ScanStore::add_goal(double x, double y, const std::string& robot_id) {
   std::lock_guard encode_lock(encode_mutex_);
+  std::string robot;
+  std::vector<Eigen::Vector3d> claims;
   {
     std::lock_guard lock(mutex_);
-    if (!plan_) throw GoalRefused("no_map", "there is no map yet: take a first scan");
+    if (plans_.empty()) throw GoalRefused("no_map", "there is no map yet: take a first scan");
+    robot = robot_id.empty() ? latest_robot_ : robot_id;
+    if (!plans_.count(robot)) {
+      throw GoalRefused("unknown_robot",
+                        "robot '" + robot + "' has no plan: it has not sent a scan yet");
+    }
+    claims = claims_except(robot);
   }
   if (!pipeline_.regions() || !pipeline_.movable() || !pipeline_.target() ||
       pipeline_.scan_poses().empty()) {
@@ -215,8 +311,8 @@ CandidateRecord ScanStore::add_goal(double x, double y) {
                   planner_.movable.max_step_m);
     throw GoalRefused("not_movable", where + std::string(why));
   }
-  const Pose robot = pipeline_.scan_poses().back();
-  const Eigen::Vector3d from(robot.x, robot.y, robot.z);
+  const Pose at = scan_pose_of_.at(robot);
+  const Eigen::Vector3d from(at.x, at.y, at.z);
   const TravelMap travel =
       travel_map(map, movable, from, planner_.movable, planner_.stay_in_target ? &target : nullptr);
   if (!travel.reachable(cell)) {
@@ -229,30 +325,27 @@ CandidateRecord ScanStore::add_goal(double x, double y) {
   const Eigen::Vector2d centre = map.center_of(cell);
   const std::vector<Eigen::Vector2d> points = pipeline_.scan_points();
   CandidateRecord record;
-  evaluate({map, target, points, from}, planner_, {centre.x(), centre.y(), floor_z},
-           &record.candidate);
+  PlanInput input{map, target, points, from};
+  input.claimed = &claims;
+  evaluate(input, planner_, {centre.x(), centre.y(), floor_z}, &record.candidate);
   record.candidate.travel_m = travel.distance(cell);
   record.candidate.path = travel.path_to(cell);
   record.id = next_candidate_id_++;
   record.rank = 0;
   record.custom = true;
   std::lock_guard lock(mutex_);
-  plan_->candidates.push_back(record);
+  plans_.at(robot).candidates.push_back(record);
   return record;
 }
 
 bool ScanStore::set_candidate_state(std::uint64_t id, const std::string& state,
                                     const std::string& note) {
   std::lock_guard lock(mutex_);
-  if (!plan_) return false;
-  for (auto& c : plan_->candidates) {
-    if (c.id == id) {
-      c.state = state;
-      c.note = note;
-      return true;
-    }
-  }
-  return false;
+  CandidateRecord* c = find_candidate(id);
+  if (!c) return false;
+  c->state = state;
+  c->note = note;
+  return true;
 }
 
 MissionParams ScanStore::params() const {
@@ -263,10 +356,14 @@ MissionParams ScanStore::params() const {
 void ScanStore::set_params(const MissionParams& params) {
   std::lock_guard encode_lock(encode_mutex_);
   planner_ = params.planner;
+  claim_separation_m_ = params.planner.claim_separation_m;
   pipeline_.set_region_configs(params.planner.regions, params.planner.movable);
   if (params.target) pipeline_.set_target(*params.target);
-  const auto plan = refresh_derived({});
-  if (plan && on_plan) on_plan(*plan);
+  const auto plans = refresh_derived({});
+  // The plan of the robot whose scan came last goes last: it is the newest on a latched topic.
+  if (on_plan) {
+    for (auto it = plans.rbegin(); it != plans.rend(); ++it) on_plan(*it);
+  }
 }
 
 PointCloud ScanStore::points_near(double x, double y, double radius_m) const {

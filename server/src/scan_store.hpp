@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -61,8 +62,8 @@ struct CandidateRecord {
   std::uint64_t id = 0;  // unique in the session, across plans
   int rank = 0;          // 1 = best
   Candidate candidate;
-  std::string state =
-      "proposed";       // proposed, approved, rejected, moving, refused, reached, superseded
+  // proposed, moving, rejected, refused, reached, cancelled, interrupted, superseded
+  std::string state = "proposed";
   std::string note;     // why, for refused
   bool custom = false;  // proposed by the operator (POST /api/v1/goals), not by the planner
 };
@@ -125,10 +126,11 @@ class ScanStore {
   // after a scan, or a campus block, stays within a few MB a message.
   static constexpr double kThinnedMapVoxelM = 0.3;
 
-  // Told of each new thinned map (map frame, coloured, kThinnedMapVoxelM) and each new plan, in
-  // the order they were made, on the thread that made them (the intake worker, or the one
-  // changing parameters). Set them before the first add(). They run while the store's writers
-  // wait, so they must be quick and must not call add() or the params functions.
+  // Told of each new thinned map (map frame, coloured, kThinnedMapVoxelM) and each new plan
+  // (one per robot not driving to a goal; that of the robot whose scan came last told last),
+  // on the thread that made them (the intake worker, or the one changing parameters). Set them
+  // before the first add(). They run while the store's writers wait, so they must be quick and must
+  // not call add() or the params functions.
   std::function<void(const PointCloud& thinned_map)> on_map;
   std::function<void(const PlanRecord& plan)> on_plan;
 
@@ -168,16 +170,23 @@ class ScanStore {
   // The areas right after scan `id` joined the map (nothing for an unknown id).
   std::optional<MapAreas> areas_after(std::int64_t id) const;
 
-  // The latest plan (nothing before the first scan).
-  std::optional<PlanRecord> plan() const;
-  // Adds the operator's own goal at (x, y) to the latest plan as a custom candidate (rank 0),
-  // with F (Eq. 1) and the drive there over the movable region from the last scan point.
+  // Robot `robot`'s current plan; empty: that of the robot whose scan came last. Nothing before
+  // the robot's first scan.
+  std::optional<PlanRecord> plan(const std::string& robot = "") const;
+  // Every robot's current plan, by robot id.
+  std::vector<PlanRecord> plans() const;
+  // Adds the operator's own goal at (x, y) to `robot`'s plan (empty: the robot whose scan came
+  // last) as a custom candidate (rank 0), with F (Eq. 1, the other robots' goals claimed) and
+  // the drive there over the movable region from the robot's last scan point.
   // Throws GoalRefused when there is no plan yet or the robot cannot stand or get there.
-  CandidateRecord add_goal(double x, double y);
-  // Sets a candidate's state; false when the id is not in the latest plan.
+  CandidateRecord add_goal(double x, double y, const std::string& robot = "");
+  // Sets a candidate's state; false when the id is in no current plan.
   bool set_candidate_state(std::uint64_t id, const std::string& state,
                            const std::string& note = "");
   MissionParams params() const;
+  // How far apart two robots' goals must be (PlannerConfig::claim_separation_m), without
+  // waiting for a plan being made.
+  double claim_separation_m() const { return claim_separation_m_.load(); }
   // Applies new parameters and recomputes regions, layers and the plan.
   void set_params(const MissionParams& params);
 
@@ -205,11 +214,14 @@ class ScanStore {
   MapAreas areas_;
   std::map<std::int64_t, MapAreas> areas_after_;  // by scan id
   std::optional<LayerGeometry> layer_geometry_;
-  MappingPipeline pipeline_;                                // written only under encode_mutex_
-  PlannerConfig planner_;                                   // written only under encode_mutex_
-  std::pair<std::int64_t, std::string> last_scan_;          // id and robot; under encode_mutex_
+  MappingPipeline pipeline_;                        // written only under encode_mutex_
+  PlannerConfig planner_;                           // written only under encode_mutex_
+  std::pair<std::int64_t, std::string> last_scan_;  // id and robot; under encode_mutex_
+  std::map<std::string, Pose> scan_pose_of_;  // each robot's last scan pose; under encode_mutex_
   std::uint64_t next_plan_id_ = 1, next_candidate_id_ = 1;  // under encode_mutex_
-  std::optional<PlanRecord> plan_;
+  std::map<std::string, PlanRecord> plans_;                 // by robot
+  std::string latest_robot_;                                // whose scan came last
+  std::atomic<double> claim_separation_m_;
   std::map<std::string, RobotState> robots_;
   mutable std::mutex encode_mutex_;  // one writer at a time; readers keep the previous result
   std::thread encoder_;              // last member: starts once everything else exists
@@ -218,10 +230,14 @@ class ScanStore {
   // (several scans that arrived meanwhile in one go).
   void encode_loop();
 
-  // Recomputes layers, areas and the plan from the pipeline and publishes them together with
-  // whatever `commit` changes (run under mutex_); needs encode_mutex_ held. Returns the new plan
-  // (nothing when there is no map to plan on yet).
-  std::optional<PlanRecord> refresh_derived(const std::function<void()>& commit);
+  // Recomputes layers, areas and the plans from the pipeline and publishes them together with
+  // whatever `commit` changes (run under mutex_); needs encode_mutex_ held. Returns the new
+  // plans, the robot whose scan came last first (none when there is no map to plan on yet).
+  std::vector<PlanRecord> refresh_derived(const std::function<void()>& commit);
+  // Where the robots other than `robot` are going to scan next: the goals of approved moves,
+  // else the best candidates of their plans. Needs mutex_ held.
+  std::vector<Eigen::Vector3d> claims_except(const std::string& robot) const;
+  CandidateRecord* find_candidate(std::uint64_t id);  // needs mutex_ held
 };
 
 }  // namespace scanplan::server

@@ -40,7 +40,7 @@ test('a custom goal is checked against the movable region, proposed, approved an
     [{ y: 1 }, 'bad_request', /'x' is required/],
     [{ x: 'a', y: 1 }, 'bad_request', /'x' is required: a finite number/],
     [{ x: 1, y: 1, z: 0 }, 'bad_request', /unknown field 'z'/],
-    [{ x: -10, y: -8, robot: 'robot9' }, 'bad_request', /robot1/],
+    [{ x: -10, y: -8, robot: 'robot9' }, 'unknown_robot', /robot9' has no plan/],
     [{ x: 150, y: 150 }, 'outside_target', /outside the target region/],
     [{ x: 14, y: 6 }, 'no_data', /not been scanned/], // inside the building
     [{ x: -17.4, y: 8.6 }, 'not_movable', /not in the movable region/], // on the 1 m crate

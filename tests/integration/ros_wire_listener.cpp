@@ -6,7 +6,8 @@
 //   rt/scanplan/map, rt/scanplan/candidates, rt/scanplan/goal (latched: asked for with
 //   transient-local, as a late-joining ROS node would), rt/scanner/points and rt/scanner/pose
 //   (ROS 2's default subscription QoS).
-// Usage: ros_wire_listener --domain N [--seconds S]
+//   With --robots, each robot's own rt/<robot>/scanplan/candidates and rt/<robot>/scanplan/goal.
+// Usage: ros_wire_listener --domain N [--seconds S] [--robots ID,ID]
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -129,25 +130,38 @@ int main(int argc, char** argv) {
             emit(out);
           }};
     };
+    const auto poses_sub = [&](const char* name, dds_qos_t* qos) {
+      return Subscription{
+          make_reader(participant, geometry_msgs_msg_dds__PoseArray__desc, name, qos),
+          [name](const void* s, const dds_sample_info_t& info) {
+            if (!info.valid_data) return;
+            const auto& m = *static_cast<const geometry_msgs_msg_dds__PoseArray_*>(s);
+            json out = header_json(m.header);
+            out["topic"] = name;
+            out["poses"] = json::array();
+            for (std::uint32_t i = 0; i < m.poses._length; ++i) {
+              out["poses"].push_back(pose_json(m.poses._buffer[i]));
+            }
+            emit(out);
+          }};
+    };
     std::vector<Subscription> subs = {
         cloud_sub("rt/scanplan/map", latched_reader_qos()),
-        {make_reader(participant, geometry_msgs_msg_dds__PoseArray__desc, "rt/scanplan/candidates",
-                     latched_reader_qos()),
-         [](const void* s, const dds_sample_info_t& info) {
-           if (!info.valid_data) return;
-           const auto& m = *static_cast<const geometry_msgs_msg_dds__PoseArray_*>(s);
-           json out = header_json(m.header);
-           out["topic"] = "rt/scanplan/candidates";
-           out["poses"] = json::array();
-           for (std::uint32_t i = 0; i < m.poses._length; ++i) {
-             out["poses"].push_back(pose_json(m.poses._buffer[i]));
-           }
-           emit(out);
-         }},
+        poses_sub("rt/scanplan/candidates", latched_reader_qos()),
         pose_sub("rt/scanplan/goal", latched_reader_qos()),
         cloud_sub("rt/scanner/points", ros_default_reader_qos()),
         pose_sub("rt/scanner/pose", ros_default_reader_qos()),
     };
+    // Several robots: each one's own plan and goal under its ROS 2 namespace. The names must
+    // outlive the subscriptions' callbacks.
+    std::vector<std::string> names;
+    names.reserve(2 * args.robots.size());
+    for (const std::string& robot : args.robots) {
+      names.push_back("rt/" + robot + "/scanplan/candidates");
+      subs.push_back(poses_sub(names.back().c_str(), latched_reader_qos()));
+      names.push_back("rt/" + robot + "/scanplan/goal");
+      subs.push_back(pose_sub(names.back().c_str(), latched_reader_qos()));
+    }
     run_listener(participant, subs, args.seconds);
     check(dds_delete(participant), "deleting the participant");
   } catch (const std::exception& e) {

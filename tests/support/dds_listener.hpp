@@ -5,6 +5,7 @@
 // SIGTERM/SIGINT so the Node test that started them can end them.
 #include <dds/dds.h>
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -31,10 +32,11 @@ inline std::atomic<bool> g_stop{false};
 
 struct ListenerArgs {
   std::uint32_t domain = 0;
-  int seconds = 120;  // a listener never outlives a hung test by much
+  int seconds = 120;                // a listener never outlives a hung test by much
+  std::vector<std::string> robots;  // whose own topics (rt/<robot>/...) to follow as well
 };
 
-// --domain N [--seconds S]
+// --domain N [--seconds S] [--robots ID,ID]
 inline ListenerArgs parse_listener_args(int argc, char** argv) {
   ListenerArgs a;
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -43,8 +45,16 @@ inline ListenerArgs parse_listener_args(int argc, char** argv) {
       a.domain = static_cast<std::uint32_t>(std::stoul(argv[i + 1]));
     } else if (k == "--seconds") {
       a.seconds = std::stoi(argv[i + 1]);
+    } else if (k == "--robots") {
+      std::string list = argv[i + 1];
+      for (std::size_t at = 0; at <= list.size();) {
+        const std::size_t comma = std::min(list.find(',', at), list.size());
+        if (comma > at) a.robots.push_back(list.substr(at, comma - at));
+        at = comma + 1;
+      }
     } else {
-      throw std::runtime_error("unknown option " + k + "; use --domain N [--seconds S]");
+      throw std::runtime_error("unknown option " + k +
+                               "; use --domain N [--seconds S] [--robots ID,ID]");
     }
   }
   return a;

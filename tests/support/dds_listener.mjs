@@ -4,9 +4,10 @@ import { spawn } from 'node:child_process';
 import { createInterface } from 'node:readline';
 import { loopbackDds, requireEnv } from './stack.mjs';
 
-export async function startListener(envName, { seconds = 200 } = {}) {
+export async function startListener(envName, { seconds = 200, robots = [] } = {}) {
   const child = spawn(requireEnv(envName),
-    ['--domain', requireEnv('SCANPLAN_TEST_DOMAIN'), '--seconds', String(seconds)],
+    ['--domain', requireEnv('SCANPLAN_TEST_DOMAIN'), '--seconds', String(seconds),
+     ...(robots.length ? ['--robots', robots.join(',')] : [])],
     { env: { ...process.env, CYCLONEDDS_URI: loopbackDds }, stdio: ['ignore', 'pipe', 'pipe'] });
   const lines = [];
   let stderr = '';

@@ -55,6 +55,33 @@ TEST(CandidateTable, ListsRankIdStatePositionFGainsAndTravel) {
   EXPECT_EQ(render_candidate_table(candidates_answer()), expected);
 }
 
+TEST(CandidateTable, SeveralRobotsGetALineEachAndARobotColumn) {
+  json answer = candidates_answer();
+  answer["plans"] = json::array({answer["plan"],
+                                 {{"id", 4},
+                                  {"based_on_scan", 2},
+                                  {"robot", "robot2"},
+                                  {"policy", "paper"},
+                                  {"alpha", 0.5},
+                                  {"plan_ms", 99.6}}});
+  answer["candidates"][0]["robot"] = "robot1";
+  answer["candidates"][1]["robot"] = "robot2";
+  const std::vector<std::string> expected = {
+      "plan 3 after scan 2 (robot robot1, policy paper, alpha 0.50, planned in 1234 ms)",
+      "plan 4 after scan 2 (robot robot2, policy paper, alpha 0.50, planned in 100 ms)",
+      "robot      rank     id  state           x m      y m         F  gain U m2  gain M m2  "
+      "travel m",
+      "robot1        1     12  proposed       12.3     -4.6    1234.5     1000.0      234.5      "
+      "15.2",
+      "robot2        2     13  refused        -3.0      7.5      99.0       50.0       49.0       "
+      "8.0  (rubble in the way)",
+  };
+  EXPECT_EQ(render_candidate_table(answer), expected);
+  // One robot's plan in "plans" reads as before.
+  answer["plans"] = json::array({answer["plan"]});
+  EXPECT_EQ(render_candidate_table(answer)[1].substr(0, 4), "rank");
+}
+
 TEST(CandidateTable, SaysWhenThereIsNoPlanOrNoCandidate) {
   EXPECT_EQ(render_candidate_table(json::parse(R"({"plan":null,"candidates":[]})")),
             std::vector<std::string>{

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "scanplan/core/scan_claims.hpp"
 #include "scanplan/core/simulated_scanner.hpp"
 
 namespace scanplan {
@@ -227,6 +228,80 @@ TEST_F(WallYard, ConfigOutOfRangeIsRefused) {
   cfg = {};
   EXPECT_THROW(plan_next_scan({*map_, *target_, scan_points_, {std::nan(""), 0, 0}}, cfg),
                std::invalid_argument);
+}
+
+// Two robots on one map: robot A is going past the wall's end; robot B, planned next with A's
+// goal claimed, is sent elsewhere, and what A will see no longer counts for B.
+TEST_F(WallYard, AClaimedScanPointSendsTheNextRobotElsewhere) {
+  for (const PlannerPolicy p : {PlannerPolicy::kPaper, PlannerPolicy::kExhaustive,
+                                PlannerPolicy::kTravel, PlannerPolicy::kNearestFrontier}) {
+    const Candidate a = plan(p, 0.5).ranked.front();
+    ASSERT_TRUE(past_the_wall(a)) << policy_name(p);
+    const std::vector<Eigen::Vector3d> claimed = {a.position};
+    PlannerConfig cfg;
+    cfg.policy = p;
+    PlanInput in = input();
+    in.claimed = &claimed;
+    const Plan b = plan_next_scan(in, cfg);
+    ASSERT_FALSE(b.ranked.empty()) << policy_name(p);
+    for (const Candidate& c : b.ranked) {
+      EXPECT_GE((c.position - a.position).head<2>().norm(), cfg.claim_separation_m)
+          << policy_name(p) << " " << c.position.transpose();
+    }
+    // The map's own segmentation is returned, not the claimed one.
+    const Plan alone = plan(p, 0.5);
+    EXPECT_EQ(b.regions.unscanned, alone.regions.unscanned);
+    EXPECT_EQ(b.regions.completed, alone.regions.completed);
+  }
+  // F with A's claim is what is left after A's scan: B's best is no longer behind the wall,
+  // where A will look, and F there is at most what it is alone.
+  const Candidate a = plan(PlannerPolicy::kExhaustive, 0.5).ranked.front();
+  const std::vector<Eigen::Vector3d> claimed = {a.position};
+  PlanInput in = input();
+  in.claimed = &claimed;
+  PlannerConfig cfg;
+  cfg.policy = PlannerPolicy::kExhaustive;
+  const Candidate b = plan_next_scan(in, cfg).ranked.front();
+  EXPECT_FALSE(past_the_wall(b)) << b.position.transpose();
+  EXPECT_LE(b.f, evaluate(input(), cfg, b.position));
+  EXPECT_DOUBLE_EQ(evaluate(in, cfg, b.position), b.f);
+  // A second scan at A's own point gains next to nothing once A's is claimed.
+  EXPECT_LT(evaluate(in, cfg, a.position), 0.05 * a.f);
+}
+
+TEST_F(WallYard, ClaimingAScanMarksWhatItWouldSeeAsSegmentationWould) {
+  PlannerConfig cfg;
+  RegionMap regions = segment_regions(*map_, *target_, scan_points_, cfg.regions);
+  const std::size_t total = regions.completed + regions.low_resolution + regions.unscanned;
+  const RegionMap before = regions;
+  const VisibilityPredictor predictor(*map_, regions.cells, cfg.visibility);
+  const Eigen::Vector3d claim(55.5, 36.5, 0.0);  // past the wall's north end
+  const std::size_t changed = claim_predicted_scans(regions, predictor, {claim}, cfg.regions);
+  EXPECT_GT(changed, 500u);
+  EXPECT_EQ(regions.completed + regions.low_resolution + regions.unscanned, total);
+  EXPECT_LT(regions.unscanned, before.unscanned);
+  EXPECT_GT(regions.completed, before.completed);
+  // Only upwards (U → M → C), and C only within the completed radius of the claim.
+  for (std::size_t o = 0; o < regions.cells.values.size(); ++o) {
+    const Region was = before.cells.values[o], now = regions.cells.values[o];
+    EXPECT_GE(static_cast<int>(now), static_cast<int>(was));
+    if (now == Region::kCompleted && was != Region::kCompleted) {
+      const Eigen::Vector2d c = map_->center_of(regions.cells.index_at(o));
+      EXPECT_LT((c - claim.head<2>()).norm(), cfg.regions.completed_radius_m + 1.5);
+    }
+  }
+  // Off the map a claim sees nothing.
+  EXPECT_EQ(claim_predicted_scans(regions, predictor, {{900, 900, 0}}, cfg.regions), 0u);
+}
+
+TEST_F(WallYard, ANonFiniteClaimIsRefused) {
+  const std::vector<Eigen::Vector3d> claimed = {{std::nan(""), 1, 0}};
+  PlanInput in = input();
+  in.claimed = &claimed;
+  EXPECT_THROW(plan_next_scan(in, PlannerConfig{}), std::invalid_argument);
+  PlannerConfig cfg;
+  cfg.claim_separation_m = -1;
+  EXPECT_THROW(plan_next_scan(input(), cfg), std::invalid_argument);
 }
 
 TEST(PlannerPolicyNames, ParseAndPrintRoundTrip) {

@@ -1,5 +1,5 @@
-// The planner's suggestions (GET /api/v1/candidates) as a ranked list, the selected one's details
-// (F, gains, drive), and the operator's decisions on it: approve, reject, cancel a move, each after
+// The planner's suggestions (GET /api/v1/candidates: one plan per robot) as ranked lists, the
+// selected one's details (F, gains, drive), and the operator's decisions on it: approve, reject, cancel a move, each after
 // a confirmation (POST /api/v1/candidates/{id}/approve|reject|cancel). Viewers see no buttons.
 import { sendJson } from './api.js';
 import { confirmAction } from './dialog.js';
@@ -40,6 +40,7 @@ export class CandidatesPanel {
     this.onSelect = onSelect;
     this.onChanged = onChanged;
     this.plan = null;
+    this.plans = [];
     this.list = [];
     this.selected = null;
     this.operator = false;
@@ -53,9 +54,10 @@ export class CandidatesPanel {
     this.render();
   }
 
-  /** @param {{plan: object|null, candidates: object[]}} answer */
+  /** @param {{plan: object|null, plans: object[], candidates: object[]}} answer */
   setData(answer) {
     this.plan = answer.plan;
+    this.plans = answer.plans || (answer.plan ? [answer.plan] : []);
     this.list = (answer.candidates || []).filter((c) => c.state !== 'superseded');
     if (this.selected != null && !this.list.some((c) => c.id === this.selected)) {
       this.selected = null;
@@ -81,8 +83,18 @@ export class CandidatesPanel {
     return this.list.find((c) => c.id === this.selected) || null;
   }
 
-  get moving() {
-    return this.list.find((c) => c.state === 'moving') || null;
+  /** Every robot's approved move under way. */
+  get movingAll() {
+    return this.list.filter((c) => c.state === 'moving');
+  }
+
+  /** The move `robot` is carrying out, if any. */
+  movingOf(robot) {
+    return this.list.find((c) => c.state === 'moving' && c.robot === robot) || null;
+  }
+
+  get several() {
+    return this.plans.length > 1;
   }
 
   _say(text, isError = false) {
@@ -93,7 +105,11 @@ export class CandidatesPanel {
 
   render() {
     const { list, detail, summary } = this.els;
-    if (this.plan) {
+    if (this.several) {
+      const p = this.plan;
+      summary.textContent = `${this.plans.length} robots, one plan each, no two sent to one spot · ${p.policy}, α ${p.alpha} · ` +
+        this.plans.map((q) => `${q.robot}: plan ${q.id}`).join(', ');
+    } else if (this.plan) {
       const p = this.plan;
       summary.textContent = `plan ${p.id} after scan ${p.based_on_scan} · ${p.policy}, α ${p.alpha} · ${nf0.format(p.plan_ms)} ms`;
     } else {
@@ -105,10 +121,12 @@ export class CandidatesPanel {
       list.append(el('div', 'empty', this.plan ? 'the planner found no scan point worth making' : 'no candidates yet'));
     }
     for (const c of this.list) {
-      const row = el('button', `cand-row state-${c.state}${c.id === this.selected ? ' selected' : ''}`);
+      const row = el('button', `cand-row state-${c.state}${c.id === this.selected ? ' selected' : ''}${this.several ? ' with-robot' : ''}`);
       row.type = 'button';
       row.dataset.id = String(c.id);
       row.dataset.state = c.state;
+      if (c.robot) row.dataset.robot = c.robot;
+      if (this.several) row.append(el('span', 'robot-chip', c.robot));
       row.append(
         el('span', `rank${c.custom ? ' custom' : ''}`, c.custom ? 'C' : String(c.rank)),
         el('span', 'f', `F ${nf0.format(c.f)}`),
@@ -116,7 +134,7 @@ export class CandidatesPanel {
         el('span', 'travel', `${nf1.format(c.travel_m)} m`),
         el('span', 'chip', STATE_TEXT[c.state] ?? c.state),
       );
-      row.title = `${candidateName(c)} at (${nf1.format(c.x)}, ${nf1.format(c.y)})`;
+      row.title = `${candidateName(c)}${c.robot ? ` for ${c.robot}` : ''} at (${nf1.format(c.x)}, ${nf1.format(c.y)})`;
       row.addEventListener('click', () => this.select(c.id));
       list.append(row);
     }
@@ -126,7 +144,7 @@ export class CandidatesPanel {
     if (!c) {
       detail.append(el('div', 'hint', this.list.length ? 'select a candidate in the list or on the top view' : ''));
     } else {
-      const title = el('div', 'detail-title', `${candidateName(c)} — ${STATE_TEXT[c.state] ?? c.state}`);
+      const title = el('div', 'detail-title', `${candidateName(c)}${this.several ? ` for ${c.robot}` : ''} — ${STATE_TEXT[c.state] ?? c.state}`);
       const grid = el('dl', 'facts');
       const fact = (k, v) => grid.append(el('dt', '', k), el('dd', '', v));
       fact('F (Eq. 1)', nf1.format(c.f));
@@ -144,8 +162,10 @@ export class CandidatesPanel {
           const approve = el('button', 'primary', 'Approve move…');
           approve.id = 'approve';
           approve.type = 'button';
-          approve.disabled = this.busy || !!this.moving;
-          if (this.moving) approve.title = 'the robot is still driving to another point';
+          // Each robot's move is approved on its own; only this candidate's robot must be free.
+          const busyRobot = this.movingOf(c.robot);
+          approve.disabled = this.busy || !!busyRobot;
+          if (busyRobot) approve.title = `${c.robot || 'the robot'} is still driving to another point`;
           approve.addEventListener('click', () => this.approve(c));
           const reject = el('button', '', 'Reject…');
           reject.id = 'reject';
@@ -184,7 +204,7 @@ export class CandidatesPanel {
   }
 
   async approve(c) {
-    const robot = this.plan?.robot || 'the robot';
+    const robot = c.robot || this.plan?.robot || 'the robot';
     const ok = await confirmAction({
       title: `Approve ${candidateName(c)}?`,
       body: `${robot} will drive ${nf1.format(c.travel_m)} m to (${nf1.format(c.x)}, ${nf1.format(c.y)}) and scan there. Expected gain: F ${nf0.format(c.f)} (${nf0.format(c.gain_unscanned_m2)} m² unscanned, ${nf0.format(c.gain_low_res_m2)} m² low-resolution).`,

@@ -1,5 +1,5 @@
 // The operator's own scan point: a click on the top view marks a spot; "Propose" sends it to
-// POST /api/v1/goals {x, y, by}. The server checks it against the movable region and answers with a
+// POST /api/v1/goals {x, y, robot, by}. The server checks it against the movable region and answers with a
 // custom candidate (F, gains, drive) to approve like the planner's, or 400 with the reason, shown here.
 import { sendJson } from './api.js';
 import { operatorName } from './dialog.js';
@@ -9,11 +9,13 @@ const f1 = (v) => v.toFixed(1);
 export class GoalPicker {
   /**
    * @param {{bar: HTMLElement, where: HTMLElement, propose: HTMLButtonElement, clear: HTMLButtonElement, msg: HTMLElement}} els
-   * @param {{onPending: (p: {x, y}|null) => void, onProposed: (candidate: object) => void}} handlers
+   * @param {{onPending: (p: {x, y}|null) => void, onProposed: (candidate: object) => void,
+   *          robotFor?: () => string|null}} handlers  robotFor: which robot the point is for (null: the server's choice)
    */
-  constructor(els, { onPending, onProposed }) {
+  constructor(els, { onPending, onProposed, robotFor = () => null }) {
     this.els = els;
     this.onPending = onPending;
+    this.robotFor = robotFor;
     this.onProposed = onProposed;
     this.point = null;
     this.operator = false;
@@ -39,7 +41,8 @@ export class GoalPicker {
     const { bar, where, propose } = this.els;
     bar.hidden = !this.point;
     if (!this.point) return;
-    where.textContent = `(${f1(this.point.x)}, ${f1(this.point.y)})`;
+    const robot = this.robotFor();
+    where.textContent = `(${f1(this.point.x)}, ${f1(this.point.y)})${robot ? ` for ${robot}` : ''}`;
     propose.hidden = !this.operator;
     propose.disabled = this.busy;
   }
@@ -53,7 +56,8 @@ export class GoalPicker {
     this.render();
     try {
       const by = operatorName();
-      const c = await sendJson('/api/v1/goals', { x: this.point.x, y: this.point.y, ...(by ? { by } : {}) });
+      const robot = this.robotFor();
+      const c = await sendJson('/api/v1/goals', { x: this.point.x, y: this.point.y, ...(robot ? { robot } : {}), ...(by ? { by } : {}) });
       this.busy = false;
       this.set(null);
       this.onProposed(c);

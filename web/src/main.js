@@ -80,6 +80,8 @@ const goals = new GoalPicker(
   { bar: $('goal-bar'), where: $('goal-where'), propose: $('goal-propose'), clear: $('goal-clear'), msg: $('goal-msg') },
   {
     onPending: (p) => topView.setPending(p),
+    // With several robots the point is for the robot of the selected candidate.
+    robotFor: () => (candidates.several ? candidates.current?.robot ?? candidates.plan?.robot ?? null : null),
     onProposed: async (c) => {
       await refreshCandidates();
       candidates.select(c.id);
@@ -361,19 +363,21 @@ async function resync() {
 // ---------------------------------------------------------------- robot, path
 function updateRobot() {
   const robots = state.session?.robots || {};
-  const ids = Object.keys({ ...robots, ...mission.robots });
-  const id = candidates.plan?.robot && ids.includes(candidates.plan.robot) ? candidates.plan.robot : ids[0];
-  const pose = id ? mission.robotPose(id) : null;
-  markers?.setRobot(pose, id);
-  topView.setRobot(pose);
-  const moving = candidates.moving;
-  if (moving && pose) {
-    markers?.setPath(moving.path, pose.z ?? moving.z, moving.z);
-    mission.setGoalDistance(Math.hypot(moving.x - pose.x, moving.y - pose.y));
-  } else {
-    markers?.setPath(null);
-    mission.setGoalDistance(null);
+  const ids = Object.keys({ ...robots, ...mission.robots }).sort();
+  const placed = ids.map((id) => ({ id, pose: mission.robotPose(id) }));
+  markers?.setRobots(placed);
+  topView.setRobots(placed);
+  // Each driving robot's path from where it is, and what is left of the drive.
+  const drives = [];
+  const toGo = {};
+  for (const moving of candidates.movingAll) {
+    const pose = mission.robotPose(moving.robot);
+    if (!pose) continue;
+    drives.push({ path: moving.path, z0: pose.z ?? moving.z, z1: moving.z });
+    toGo[moving.robot] = Math.hypot(moving.x - pose.x, moving.y - pose.y);
   }
+  markers?.setPaths(drives);
+  mission.setGoalDistances(toGo);
 }
 
 // ---------------------------------------------------------------- live events

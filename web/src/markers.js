@@ -72,7 +72,6 @@ export class Markers {
     };
     this.materials = new Map(); // colour -> material
     this.lineMaterials = [];
-    this.pathLine = null;
   }
 
   _mat(color) {
@@ -95,10 +94,8 @@ export class Markers {
       });
       for (const l of labels) l.parent.remove(l);
       g.remove(child);
-    }
-    if (name === 'path' && this.pathLine) {
-      this.pathLine.geometry.dispose();
-      this.pathLine = null;
+      // Path lines have geometries of their own (the other groups share this.geo).
+      if (name === 'path') child.geometry?.dispose();
     }
   }
 
@@ -139,40 +136,38 @@ export class Markers {
   }
 
   /**
-   * The drive of an approved move: 2-D path points lifted between the robot's height and the goal's.
-   * @param {Array<[number, number]>|null} path
+   * The drives of approved moves, one per robot: 2-D path points lifted between the robot's height
+   * and the goal's.
+   * @param {Array<{path: Array<[number, number]>, z0: number, z1: number}>} drives
    */
-  setPath(path, z0 = 0, z1 = 0) {
+  setPaths(drives) {
     this._clear('path');
-    if (!path || path.length < 2) {
-      this.view.requestRender();
-      return;
-    }
-    const pts = path.map(([x, y], i) => new Vector3(x, y, z0 + ((z1 - z0) * i) / (path.length - 1) + 0.2));
     if (!this.lineMaterials.length) {
       this.lineMaterials.push(new LineBasicMaterial({ color: STATE_COLORS.moving, depthTest: false, transparent: true }));
     }
-    this.pathLine = overlay(new Line(new BufferGeometry().setFromPoints(pts), this.lineMaterials[0]));
-    this.groups.path.add(this.pathLine);
+    for (const { path, z0 = 0, z1 = 0 } of drives) {
+      if (!path || path.length < 2) continue;
+      const pts = path.map(([x, y], i) => new Vector3(x, y, z0 + ((z1 - z0) * i) / (path.length - 1) + 0.2));
+      this.groups.path.add(overlay(new Line(new BufferGeometry().setFromPoints(pts), this.lineMaterials[0])));
+    }
     this.view.requestRender();
   }
 
-  /** @param {{x: number, y: number, z: number, yaw_deg: number}|null} pose */
-  setRobot(pose, name = 'robot') {
+  /** @param {Array<{id: string, pose: {x: number, y: number, z: number, yaw_deg: number}}>} robots */
+  setRobots(robots) {
     this._clear('robot');
-    if (!pose || !Number.isFinite(pose.x)) {
-      this.view.requestRender();
-      return;
+    for (const { id, pose } of robots) {
+      if (!pose || !Number.isFinite(pose.x)) continue;
+      const g = new Group();
+      g.add(overlay(new Mesh(this.geo.body, this._mat(ROBOT_COLOR))));
+      g.add(overlay(new Mesh(this.geo.nose, this._mat(ROBOT_COLOR))));
+      const l = label(id, 'robot-label');
+      l.position.set(0, 0, 1.1);
+      g.add(l);
+      g.position.set(pose.x, pose.y, pose.z || 0);
+      g.rotation.z = ((pose.yaw_deg || 0) * Math.PI) / 180;
+      this.groups.robot.add(g);
     }
-    const g = new Group();
-    g.add(overlay(new Mesh(this.geo.body, this._mat(ROBOT_COLOR))));
-    g.add(overlay(new Mesh(this.geo.nose, this._mat(ROBOT_COLOR))));
-    const l = label(name, 'robot-label');
-    l.position.set(0, 0, 1.1);
-    g.add(l);
-    g.position.set(pose.x, pose.y, pose.z || 0);
-    g.rotation.z = ((pose.yaw_deg || 0) * Math.PI) / 180;
-    this.groups.robot.add(g);
     this.view.requestRender();
   }
 

@@ -29,7 +29,7 @@ export class MissionPanel {
     this.match = null;
     this.matches = new Map(); // scan id -> match_done event seen by this page
     this.corrections = new Map(); // scan id -> placed − estimated, from GET /api/v1/scans
-    this.goalDistance = null;
+    this.goalDistances = {};
     this.operator = false;
     this.bridges = 0;
     els.scanHere.addEventListener('click', () => this.scanHere());
@@ -137,8 +137,9 @@ export class MissionPanel {
   }
 
   /** Distance left to the goal of a move under way (or null). */
-  setGoalDistance(d) {
-    this.goalDistance = d;
+  /** Metres left to each driving robot's goal, by robot id. */
+  setGoalDistances(byRobot) {
+    this.goalDistances = byRobot;
     this.render();
   }
 
@@ -182,7 +183,8 @@ export class MissionPanel {
         extra = `no contact${when}${r.lostReason ? `: ${r.lostReason}` : ''}`;
         line.title = extra;
       }
-      if (r.state === 'moving' && this.goalDistance != null) extra = `${this.goalDistance.toFixed(1)} m to go${extra ? ` · ${extra}` : ''}`;
+      const toGo = this.goalDistances?.[id];
+      if (r.state === 'moving' && toGo != null) extra = `${toGo.toFixed(1)} m to go${extra ? ` · ${extra}` : ''}`;
       if (extra) {
         const m = document.createElement('span');
         m.className = 'muted';

@@ -24,7 +24,7 @@ export class TopView {
     this.scans = [];
     this.candidates = [];
     this.selected = null;
-    this.robot = null;
+    this.robots = [];
     this.annotations = [];
     this.pending = null; // {x, y}: a point the operator clicked, before proposing it
     this.dataBounds = null;
@@ -108,8 +108,9 @@ export class TopView {
     this.redraw();
   }
 
-  setRobot(pose) {
-    this.robot = pose;
+  /** @param {Array<{id: string, pose: object}>} robots */
+  setRobots(robots) {
+    this.robots = robots;
     this.redraw();
   }
 
@@ -304,9 +305,11 @@ export class TopView {
       ctx.strokeRect(p.x - 4, p.y - 4, 8, 8);
     }
 
-    if (this.robot && Number.isFinite(this.robot.x)) {
-      const p = this.screenOf(this.robot.x, this.robot.y);
-      const yaw = ((this.robot.yaw_deg || 0) * Math.PI) / 180;
+    const named = this.robots.length > 1;
+    for (const { id, pose } of this.robots) {
+      if (!pose || !Number.isFinite(pose.x)) continue;
+      const p = this.screenOf(pose.x, pose.y);
+      const yaw = ((pose.yaw_deg || 0) * Math.PI) / 180;
       ctx.save();
       ctx.translate(p.x, p.y);
       ctx.rotate(-yaw);
@@ -322,6 +325,16 @@ export class TopView {
       ctx.strokeStyle = '#0d1117';
       ctx.stroke();
       ctx.restore();
+      if (named) {
+        ctx.font = '11px system-ui, sans-serif';
+        ctx.textAlign = 'left';
+        ctx.textBaseline = 'middle';
+        ctx.lineWidth = 3;
+        ctx.strokeStyle = '#0d1117';
+        ctx.strokeText(id, p.x + 12, p.y - 10);
+        ctx.fillStyle = '#ffb27a';
+        ctx.fillText(id, p.x + 12, p.y - 10);
+      }
     }
 
     if (this.pending) {

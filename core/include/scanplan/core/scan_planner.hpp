@@ -58,6 +58,11 @@ struct PlannerConfig {
   // Candidates in the ranked list lie at least this far apart, so that the operator chooses
   // among different places rather than neighbouring cells of one.
   double candidate_separation_m = 5.0;
+  // Several robots on one map (PlanInput::claimed): no candidate lies this close to where
+  // another robot is going to scan, so two robots are never sent to the same spot. Half the
+  // paper's 20 m completed radius (§3.3): nearer than that, two scans mostly complete the same
+  // ground, which the claimed gains already discount.
+  double claim_separation_m = 10.0;
   // A scan that would gain less than this (F, in m²) is not worth making.
   double min_gain_m2 = 1.0;
   // Candidates and paths keep to cells whose centre is in the target region.
@@ -85,11 +90,18 @@ struct PlanInput {
   const TargetRegion& target;
   const std::vector<Eigen::Vector2d>& scan_points;  // where scans were taken (x, y)
   Eigen::Vector3d robot;                            // x, y, floor z
+  // Where other robots on the same map are going to scan next (x, y, floor z): their approved
+  // goals, or the best candidates of their own plans. Planning for several robots one after
+  // another (a sequential greedy coordination, as in Burgard et al.'s coordinated
+  // exploration), each robot's F counts what a scan at a claimed point is predicted to see as
+  // already taken: U it would see becomes M or C, M it would see within the completed radius
+  // becomes C, as segment_regions would have it after that scan. Null or empty: one robot.
+  const std::vector<Eigen::Vector3d>* claimed = nullptr;
 };
 
 struct Plan {
   std::vector<Candidate> ranked;  // best first
-  RegionMap regions;
+  RegionMap regions;              // the map's C/M/U segmentation (without the claims)
   MovableRegion movable;
   std::size_t evaluations = 0;  // F computations made
   double plan_ms = 0;

@@ -1,5 +1,8 @@
 #pragma once
 
+#include <optional>
+#include <string>
+
 // Topic names (DESIGN.md "DDS"): ROS-typed topics carry the ROS 2 `rt/` prefix so that a
 // ROS 2 node on rmw_cyclonedds sees them as /scanner/points etc.
 namespace scanplan::topics {
@@ -18,6 +21,21 @@ inline constexpr const char* kMap = "rt/scanplan/map";
 inline constexpr const char* kCandidates = "rt/scanplan/candidates";
 inline constexpr const char* kGoal = "rt/scanplan/goal";
 inline constexpr const char* kAnnotation = "scanplan_Annotation";
+// Several robots: each robot's own plan and goal also go out under its namespace, as ROS 2
+// namespaces a robot's topics (/robot2/scanplan/candidates): "rt/<robot>/scanplan/candidates".
+inline constexpr const char* kRobotCandidatesSuffix = "/scanplan/candidates";
+inline constexpr const char* kRobotGoalSuffix = "/scanplan/goal";
+
+// "rt/<robot><suffix>", or nothing when the robot id cannot be a ROS 2 namespace (a letter,
+// then letters, digits and underscores).
+inline std::optional<std::string> robot_topic(const std::string& robot, const char* suffix) {
+  const auto alpha = [](char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'); };
+  if (robot.empty() || !alpha(robot[0])) return std::nullopt;
+  for (const char c : robot) {
+    if (!alpha(c) && !(c >= '0' && c <= '9') && c != '_') return std::nullopt;
+  }
+  return "rt/" + robot + suffix;
+}
 // header.frame_id of what the server publishes in the map frame. Plain "map", the frame name ROS
 // tools (rviz, nav2) expect, since these topics are about the shared map rather than one robot.
 inline constexpr const char* kMapFrame = "map";
