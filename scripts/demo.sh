@@ -29,7 +29,7 @@ token=${SCANPLAN_OPERATOR_TOKEN:-$(head -c 16 /dev/urandom | od -An -tx1 | tr -d
 export SCANPLAN_OPERATOR_TOKEN=$token
 
 # The world's "start": [x, y, yaw_deg].
-read -r start_x start_y start_yaw < <(tr -d '\n' <"$world" | grep -o '"start"[^]]*' | tr -c '0-9.,-' ' ' | tr ',' ' ')
+read -r start_x start_y start_yaw <<<"$(tr -d '\n' <"$world" | grep -o '"start"[^]]*' | tr -c '0-9.,-' ' ' | tr ',' ' ')"
 for k in $(seq 1 "$robots"); do
   start_var=START$k
   start=${!start_var:-}

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "scanplan/core/draco_codec.hpp"
+#include "scanplan/core/fleet_planner.hpp"
 #include "scanplan/core/top_view.hpp"
 #include "scanplan/core/travel_map.hpp"
 
@@ -106,9 +107,8 @@ void ScanStore::add(const StoredScan& scan, const PointCloud& cloud) {
   // Outside mutex_ so readers are not held up, inside encode_mutex_ so maps and plans go out in
   // the order they were made; the map first, as the plan is made from it.
   if (on_map) on_map(thinned_.cloud());
-  // The plan of the robot whose scan came last goes last: it is the newest on a latched topic.
   if (on_plan) {
-    for (auto it = plans.rbegin(); it != plans.rend(); ++it) on_plan(*it);
+    for (const PlanRecord& plan : plans) on_plan(plan);
   }
 }
 
@@ -153,10 +153,10 @@ std::vector<PlanRecord> ScanStore::refresh_derived(const std::function<void()>& 
   const MovableRegion& movable = *pipeline_.movable();
   const std::vector<Eigen::Vector2d> points = pipeline_.scan_points();
 
-  // Several robots share the map: they are planned one after another, each counting what the
-  // robots before it will scan as taken (PlanInput::claimed), so no two are sent to one spot.
-  // A robot driving to an approved goal keeps its plan, and its goal is claimed first. The
-  // robot whose scan came last is planned next: it is the one waiting for a decision.
+  // Several robots share the map: they are decided one after another (plan_fleet), each
+  // counting what the robots before it will scan as taken (PlanInput::claimed), so no two are
+  // sent to one spot. A robot driving to an approved goal keeps its plan, and its goal is
+  // claimed first.
   std::vector<Eigen::Vector3d> claims;
   std::set<std::string> driving;
   {
@@ -169,24 +169,18 @@ std::vector<PlanRecord> ScanStore::refresh_derived(const std::function<void()>& 
       }
     }
   }
-  std::vector<std::string> order;
-  if (scan_pose_of_.count(last_scan_.second)) order.push_back(last_scan_.second);
-  for (const auto& [robot, pose] : scan_pose_of_) {
-    if (robot != last_scan_.second) order.push_back(robot);
+  std::vector<FleetRobot> robots;
+  for (const auto& [robot, at] : scan_pose_of_) {
+    if (!driving.count(robot)) robots.push_back({robot, {at.x, at.y, at.z}});
   }
   std::vector<PlanRecord> records;
-  for (const std::string& robot : order) {
-    if (driving.count(robot)) continue;
-    const Pose& at = scan_pose_of_.at(robot);
-    PlanInput input{pipeline_.map(), *pipeline_.target(), points, {at.x, at.y, at.z}};
-    input.claimed = &claims;
-    const Plan plan = plan_next_scan(input, planner_);
-    if (!plan.ranked.empty()) claims.push_back(plan.ranked.front().position);
-
+  for (FleetPlan& decided : plan_fleet(pipeline_.map(), *pipeline_.target(), points, robots,
+                                       std::move(claims), planner_)) {
+    const Plan& plan = decided.plan;
     PlanRecord record;
     record.id = next_plan_id_++;
     record.based_on_scan = last_scan_.first;
-    record.robot = robot;
+    record.robot = decided.robot;
     for (std::size_t k = 0; k < plan.ranked.size(); ++k) {
       CandidateRecord c;
       c.id = next_candidate_id_++;
@@ -199,6 +193,10 @@ std::vector<PlanRecord> ScanStore::refresh_derived(const std::function<void()>& 
     record.plan_ms = plan.plan_ms;
     records.push_back(std::move(record));
   }
+  // The robot whose scan came last is the one waiting for a decision: its plan goes last, the
+  // newest on the latched DDS topic.
+  std::stable_partition(records.begin(), records.end(),
+                        [&](const PlanRecord& r) { return r.robot != last_scan_.second; });
 
   const auto png = [](const cv::Mat& img) {
     return std::make_shared<const std::vector<std::uint8_t>>(encode_png(img));
@@ -360,9 +358,8 @@ void ScanStore::set_params(const MissionParams& params) {
   pipeline_.set_region_configs(params.planner.regions, params.planner.movable);
   if (params.target) pipeline_.set_target(*params.target);
   const auto plans = refresh_derived({});
-  // The plan of the robot whose scan came last goes last: it is the newest on a latched topic.
   if (on_plan) {
-    for (auto it = plans.rbegin(); it != plans.rend(); ++it) on_plan(*it);
+    for (const PlanRecord& plan : plans) on_plan(plan);
   }
 }
 

@@ -232,7 +232,7 @@ class ScanStore {
 
   // Recomputes layers, areas and the plans from the pipeline and publishes them together with
   // whatever `commit` changes (run under mutex_); needs encode_mutex_ held. Returns the new
-  // plans, the robot whose scan came last first (none when there is no map to plan on yet).
+  // plans, that of the robot whose scan came last last (none when there is no map to plan on).
   std::vector<PlanRecord> refresh_derived(const std::function<void()>& commit);
   // Where the robots other than `robot` are going to scan next: the goals of approved moves,
   // else the best candidates of their plans. Needs mutex_ held.

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "scanplan/core/fleet_planner.hpp"
 #include "scanplan/core/scan_claims.hpp"
 #include "scanplan/core/simulated_scanner.hpp"
 
@@ -267,6 +268,36 @@ TEST_F(WallYard, AClaimedScanPointSendsTheNextRobotElsewhere) {
   EXPECT_DOUBLE_EQ(evaluate(in, cfg, b.position), b.f);
   // A second scan at A's own point gains next to nothing once A's is claimed.
   EXPECT_LT(evaluate(in, cfg, a.position), 0.05 * a.f);
+}
+
+// Two robots on one map: the spot past the wall goes to the robot nearer it, whichever is listed
+// first, and the other is sent at least claim_separation_m away.
+TEST_F(WallYard, TheFleetGivesTheBestSpotToTheNearerRobot) {
+  const FleetRobot far{"far", {40, 20, 0}}, near{"near", {47, 30, 0}};
+  PlannerConfig cfg;
+  cfg.policy = PlannerPolicy::kExhaustive;
+  const double alone = plan(PlannerPolicy::kExhaustive, 0.5).ranked.front().f;
+  for (const auto& robots :
+       {std::vector<FleetRobot>{far, near}, std::vector<FleetRobot>{near, far}}) {
+    const std::vector<FleetPlan> plans = plan_fleet(*map_, *target_, scan_points_, robots, {}, cfg);
+    ASSERT_EQ(plans.size(), 2u);
+    EXPECT_EQ(plans[0].robot, "near");
+    EXPECT_EQ(plans[1].robot, "far");
+    ASSERT_FALSE(plans[0].plan.ranked.empty());
+    ASSERT_FALSE(plans[1].plan.ranked.empty());
+    const Candidate& first = plans[0].plan.ranked.front();
+    EXPECT_TRUE(past_the_wall(first)) << first.position.transpose();
+    EXPECT_GE(first.f, 0.98 * alone);
+    for (const Candidate& c : plans[1].plan.ranked) {
+      EXPECT_GE((c.position - first.position).head<2>().norm(), cfg.claim_separation_m);
+    }
+  }
+  // One robot: the single-robot plan.
+  const auto one = plan_fleet(*map_, *target_, scan_points_, {far}, {}, cfg);
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_DOUBLE_EQ(one[0].plan.ranked.front().f, alone);
+  cfg.fleet_tie_share = 1.5;
+  EXPECT_THROW(plan_fleet(*map_, *target_, scan_points_, {far}, {}, cfg), std::invalid_argument);
 }
 
 TEST_F(WallYard, ClaimingAScanMarksWhatItWouldSeeAsSegmentationWould) {

@@ -115,9 +115,11 @@ export class Markers {
     this.view.requestRender();
   }
 
-  /** Candidates of the current plan; `selected` is a candidate id or null. */
+  /** Candidates of the current plans; `selected` is a candidate id or null. */
   setCandidates(list, selected) {
     this._clear('candidates');
+    // With several robots each label says whose plan it is from.
+    const several = new Set(list.map((c) => c.robot)).size > 1;
     for (const c of list) {
       if (c.state === 'superseded') continue;
       const color = c.id === selected ? SELECTED_COLOR : STATE_COLORS[c.state] ?? STATE_COLORS.proposed;
@@ -125,7 +127,7 @@ export class Markers {
       g.position.set(c.x, c.y, c.z);
       g.add(overlay(new Mesh(this.geo.pin, this._mat(color))));
       g.add(overlay(new Mesh(this.geo.head, this._mat(color))));
-      const name = c.custom ? 'custom' : `#${c.rank}`;
+      const name = `${several ? `${c.robot} ` : ''}${c.custom ? 'custom' : `#${c.rank}`}`;
       const l = label(`${name} · F ${Math.round(c.f)}`, `cand-label state-${c.state}${c.id === selected ? ' selected' : ''}`);
       l.position.set(0, 0, 3.1);
       g.add(l);

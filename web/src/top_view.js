@@ -306,7 +306,7 @@ export class TopView {
     }
 
     const named = this.robots.length > 1;
-    for (const { id, pose } of this.robots) {
+    for (const [k, { id, pose }] of this.robots.entries()) {
       if (!pose || !Number.isFinite(pose.x)) continue;
       const p = this.screenOf(pose.x, pose.y);
       const yaw = ((pose.yaw_deg || 0) * Math.PI) / 180;
@@ -331,9 +331,11 @@ export class TopView {
         ctx.textBaseline = 'middle';
         ctx.lineWidth = 3;
         ctx.strokeStyle = '#0d1117';
-        ctx.strokeText(id, p.x + 12, p.y - 10);
+        // Alternately above and below, so robots side by side keep readable names.
+        const dy = k % 2 ? 13 : -13;
+        ctx.strokeText(id, p.x + 8, p.y + dy);
         ctx.fillStyle = '#ffb27a';
-        ctx.fillText(id, p.x + 12, p.y - 10);
+        ctx.fillText(id, p.x + 8, p.y + dy);
       }
     }
 

@@ -63,6 +63,9 @@ struct PlannerConfig {
   // paper's 20 m completed radius (§3.3): nearer than that, two scans mostly complete the same
   // ground, which the claimed gains already discount.
   double claim_separation_m = 10.0;
+  // Several robots (plan_fleet): best candidates scoring within this share of the highest
+  // count as equally good, and the robot with the shortest drive to its own takes it.
+  double fleet_tie_share = 0.02;
   // A scan that would gain less than this (F, in m²) is not worth making.
   double min_gain_m2 = 1.0;
   // Candidates and paths keep to cells whose centre is in the target region.
