@@ -54,9 +54,11 @@ class BridgeCommands : public ::testing::Test {
                                   ("bridge_commands_" + std::to_string(getpid()) + ".json"));
     std::ofstream(*world_file_) << world.dump();
 
+    // The status topic keeps the last sample only: a drive must last long enough (18 m at 50×:
+    // 0.7 s) for the test to see "moving" before "arrived" replaces it, on a loaded machine too.
     bridge_ =
         new test::ChildProcess(SCANPLAN_BRIDGE, {"--world", world_file_->string(), "--domain",
-                                                 std::to_string(kDomain), "--time-scale", "200"});
+                                                 std::to_string(kDomain), "--time-scale", "50"});
     participant_ = new dds::Participant(kDomain);
     using dds::QosKind;
     auto& p = *participant_;
