@@ -29,22 +29,26 @@ ScanGain ScanGainEvaluator::at(CellIndex b, double floor_z,
                                VisibilityPredictor::Workspace& ws) const {
   const auto& grid = regions_.cells;
   const std::int64_t bi = b.x - grid.origin.x, bj = b.y - grid.origin.y;
-  std::size_t unscanned = 0, low_resolution = 0;
+  std::size_t unscanned = 0, low_resolution = 0, unscanned_near = 0;
   for (const std::uint32_t o : predictor_.visible_from(b, floor_z, ws)) {
     const Region r = grid.values[o];
+    if (r != Region::kUnscanned && r != Region::kLowResolution) continue;
+    // C_B: within the completed radius of B, measured between cell centres as
+    // segment_regions measures it.
+    const double di = static_cast<double>(static_cast<std::int64_t>(o % grid.cols) - bi);
+    const double dj = static_cast<double>(static_cast<std::int64_t>(o / grid.cols) - bj);
+    const bool near = di * di + dj * dj < completed_radius_cells2_;
     if (r == Region::kUnscanned) {
       ++unscanned;
-    } else if (r == Region::kLowResolution) {
-      // C_B: within the completed radius of B, measured between cell centres as
-      // segment_regions measures it.
-      const double di = static_cast<double>(static_cast<std::int64_t>(o % grid.cols) - bi);
-      const double dj = static_cast<double>(static_cast<std::int64_t>(o / grid.cols) - bj);
-      if (di * di + dj * dj < completed_radius_cells2_) ++low_resolution;
+      unscanned_near += near;
+    } else if (near) {
+      ++low_resolution;
     }
   }
   ScanGain g;
   g.unscanned_m2 = unscanned * regions_.cell_area_m2();
   g.low_resolution_m2 = low_resolution * regions_.cell_area_m2();
+  g.completed_m2 = (unscanned_near + low_resolution) * regions_.cell_area_m2();
   g.f = alpha_ * g.unscanned_m2 + (1 - alpha_) * g.low_resolution_m2;
   return g;
 }

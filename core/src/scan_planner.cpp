@@ -60,6 +60,7 @@ void check_config(const PlannerConfig& c) {
   if (!(c.hill_climb_step_m > 0)) fail("hill_climb_step_m must be greater than zero");
   if (c.hill_climb_samples < 0) fail("hill_climb_samples must be zero or more");
   if (!(c.lattice_m > 0)) fail("lattice_m must be greater than zero");
+  if (!(c.completion_weight >= 0)) fail("completion_weight must be zero or more");
   if (c.max_candidates < 1) fail("max_candidates must be at least 1");
   if (!(c.travel_cost_per_m >= 0)) fail("travel_cost_per_m must be zero or more");
   if (!(c.travel_free_m >= 0)) fail("travel_free_m must be zero or more");
@@ -485,7 +486,12 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
       break;
     }
     case PlannerPolicy::kExhaustive: {
-      auto all = evaluate_sites(gain, sites, lattice_sites(sites, cfg.lattice_m, cell_m), threads);
+      const double w = cfg.completion_weight;
+      const Scorer with_completion = [w](std::int32_t, const ScanGain& g) {
+        return g.f + w * g.completed_m2;
+      };
+      auto all = evaluate_sites(gain, sites, lattice_sites(sites, cfg.lattice_m, cell_m), threads,
+                                with_completion);
       plan.evaluations = all.size();
       chosen = rank(std::move(all), sites, cfg, cell_m);
       break;
@@ -543,6 +549,7 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
     c.f = s.gain.f;
     c.gain_unscanned_m2 = s.gain.unscanned_m2;
     c.gain_low_res_m2 = s.gain.low_resolution_m2;
+    c.gain_completed_m2 = s.gain.completed_m2;
     c.travel_m = sites.travel_m[u];
     c.path = travel.path_to(sites.cell[u]);
     c.score = s.score;
@@ -567,6 +574,7 @@ double evaluate(const PlanInput& in, const PlannerConfig& cfg, const Eigen::Vect
     detail->f = detail->score = g.f;
     detail->gain_unscanned_m2 = g.unscanned_m2;
     detail->gain_low_res_m2 = g.low_resolution_m2;
+    detail->gain_completed_m2 = g.completed_m2;
   }
   return g.f;
 }

@@ -7,6 +7,7 @@
 
 #include "scanplan/core/draco_codec.hpp"
 #include "scanplan/core/fleet_planner.hpp"
+#include "scanplan/core/movable_region.hpp"
 #include "scanplan/core/top_view.hpp"
 #include "scanplan/core/travel_map.hpp"
 
@@ -287,8 +288,14 @@ CandidateRecord ScanStore::add_goal(double x, double y, const std::string& robot
     throw GoalRefused("no_map", "there is no map yet: take a first scan");
   }
   const MlsMap& map = pipeline_.map();
-  const MovableRegion& movable = *pipeline_.movable();
   const TargetRegion& target = *pipeline_.target();
+  const Pose at = scan_pose_of_.at(robot);
+  const Eigen::Vector3d from(at.x, at.y, at.z);
+  // The region this robot can reach, flooded from where it stands (the pipeline's is the last
+  // scanning robot's, and two robots may stand in parts of the site apart from each other).
+  const MovableRegion movable = robot == last_scan_.second
+                                    ? *pipeline_.movable()
+                                    : movable_region(map, from, planner_.movable);
   char where[64];
   std::snprintf(where, sizeof where, "(%.1f, %.1f)", x, y);
   if (!target.contains(x, y)) {
@@ -309,8 +316,6 @@ CandidateRecord ScanStore::add_goal(double x, double y, const std::string& robot
                   planner_.movable.max_step_m);
     throw GoalRefused("not_movable", where + std::string(why));
   }
-  const Pose at = scan_pose_of_.at(robot);
-  const Eigen::Vector3d from(at.x, at.y, at.z);
   const TravelMap travel =
       travel_map(map, movable, from, planner_.movable, planner_.stay_in_target ? &target : nullptr);
   if (!travel.reachable(cell)) {

@@ -438,6 +438,7 @@ int main(int argc, char** argv) {
     const Plan plain = plan_next_scan(in, cfg);
     cfg.hill_climb_samples = base.hill_climb_samples;
     cfg.policy = PlannerPolicy::kExhaustive;
+    cfg.completion_weight = 0;  // the optimum of F alone
     const Plan best = plan_next_scan(in, cfg);
     if (best.ranked.empty()) break;
     ms_paper.push_back(paper.plan_ms);

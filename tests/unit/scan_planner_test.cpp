@@ -79,12 +79,37 @@ TEST_F(WallYard, EveryPolicyFindsThePointPastTheWall) {
 }
 
 TEST_F(WallYard, HillClimbingReachesTheExhaustiveOptimum) {
-  const double best = plan(PlannerPolicy::kExhaustive, 0.5).ranked.front().f;
+  PlannerConfig exact;
+  exact.policy = PlannerPolicy::kExhaustive;
+  exact.completion_weight = 0;  // F alone: its optimum
+  const double best = plan_next_scan(input(), exact).ranked.front().f;
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
     const Plan paper = plan(PlannerPolicy::kPaper, 0.5, seed);
     EXPECT_GE(paper.ranked.front().f, 0.98 * best) << "seed " << seed;
     EXPECT_LE(paper.ranked.front().f, best);
   }
+}
+
+// Exhaustive ranks by F + w · area((U∪M)∩C_B): of two points with nearly the same F the one
+// completing more goes first, and never one whose F is more than w · (a scan's whole completed
+// disc) below the optimum.
+TEST_F(WallYard, ExhaustiveBreaksNearTiesInFByCompletion) {
+  PlannerConfig cfg;
+  cfg.policy = PlannerPolicy::kExhaustive;
+  cfg.completion_weight = 0;
+  const Candidate exact = plan_next_scan(input(), cfg).ranked.front();
+  cfg.completion_weight = 0.05;
+  const Candidate top = plan_next_scan(input(), cfg).ranked.front();
+  EXPECT_LE(top.f, exact.f);
+  EXPECT_GE(top.f, exact.f - cfg.completion_weight * M_PI * std::pow(20.0 + 1.5, 2));
+  EXPECT_GE(top.gain_completed_m2, exact.gain_completed_m2);
+  EXPECT_DOUBLE_EQ(top.score, top.f + cfg.completion_weight * top.gain_completed_m2);
+  EXPECT_GE(top.score, exact.f + cfg.completion_weight * exact.gain_completed_m2);
+  // What is completed is at most what is seen within 20 m: U and M cells in C_B.
+  EXPECT_LE(top.gain_low_res_m2, top.gain_completed_m2);
+  EXPECT_LE(top.gain_completed_m2, top.gain_low_res_m2 + top.gain_unscanned_m2);
+  cfg.completion_weight = -1;
+  EXPECT_THROW(plan_next_scan(input(), cfg), std::invalid_argument);
 }
 
 // Paper §3.4, Fig. 5/6: with α = 1 the next scan goes where the unknown is, with α = 0 where

@@ -19,7 +19,10 @@ struct CellGrid {
 
   CellGrid() = default;
   CellGrid(CellIndex origin_, int cols_, int rows_, double cell, T fill)
-      : origin(origin_), cols(cols_), rows(rows_), cell_m(cell),
+      : origin(origin_),
+        cols(cols_),
+        rows(rows_),
+        cell_m(cell),
         values(static_cast<std::size_t>(cols_) * rows_, fill) {}
 
   std::optional<std::size_t> offset(CellIndex c) const {

@@ -26,10 +26,10 @@ struct ClosedLoopConfig {
 
 // One scan of the loop and the decision taken after it.
 struct LoopStep {
-  int scan = 0;                       // 1-based
-  Pose true_pose;                     // where the robot really scanned
-  Pose reported_pose;                 // what the robot's pose sensors said
-  Pose placed_pose;                   // where the map put the scan (matched when matching is on)
+  int scan = 0;        // 1-based
+  Pose true_pose;      // where the robot really scanned
+  Pose reported_pose;  // what the robot's pose sensors said
+  Pose placed_pose;    // where the map put the scan (matched when matching is on)
   std::optional<RegistrationResult> match;
   double detected_m2 = 0;             // C ∪ M, the paper's detection area
   double completed_m2 = 0;            // C

@@ -11,8 +11,8 @@ namespace scanplan {
 
 // Paper §3.3: scan-completed (C), low-resolution (M) and unscanned (U) cells of the target region.
 enum class Region : std::uint8_t {
-  kOutside = 0,  // not in the target region
-  kUnscanned,    // U: no data (too far, or occluded)
+  kOutside = 0,    // not in the target region
+  kUnscanned,      // U: no data (too far, or occluded)
   kLowResolution,  // M: data, but farther than completed_radius_m from every scan point
   kCompleted,      // C: data within completed_radius_m of some scan point
 };

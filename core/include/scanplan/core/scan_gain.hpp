@@ -15,6 +15,9 @@ struct ScanGain {
   double f = 0;
   double unscanned_m2 = 0;       // area((U∩C_B) ∪ (U∩M_B))
   double low_resolution_m2 = 0;  // area(M_A∩C_B)
+  // area((U∪M_A)∩C_B): what the scan would bring into C. Not a term of F; the exhaustive
+  // policy breaks near-ties in F with it (PlannerConfig::completion_weight).
+  double completed_m2 = 0;
 };
 
 // Evaluates Eq. 1 at cells of the map against one region segmentation. Cheap to call many

@@ -43,6 +43,10 @@ struct PlannerConfig {
   // average, against 6% from purely random starts (docs/benchmarks.md).
   int hill_climb_samples = 1024;
   double lattice_m = 1.0;  // exhaustive: candidate spacing, in whole cells
+  // exhaustive: ranks by F + completion_weight · area((U∪M_A)∩C_B), so that of two points
+  // whose F differs by less than a few per cent (within the prediction's own error) the one
+  // that completes more ground goes first.
+  double completion_weight = 0.05;
   int max_candidates = 5;  // ranked list length
   // travel: score = F − travel_cost_per_m · F_best · max(0, drive − travel_free_m), where
   // F_best is the best F of the policy's first look over the region (its lattice sample).
@@ -81,10 +85,12 @@ struct Candidate {
   double f = 0;                                        // Eq. 1 value
   double gain_unscanned_m2 = 0;                        // area((U∩C_B) ∪ (U∩M_B))
   double gain_low_res_m2 = 0;                          // area(M_A∩C_B)
-  double travel_m = 0;                // path length over the movable region from the robot
+  double gain_completed_m2 = 0;  // area((U∪M_A)∩C_B): what the scan brings into C (not in F)
+  double travel_m = 0;           // path length over the movable region from the robot
   std::vector<Eigen::Vector2d> path;  // cell centres from the robot to B
-  // What the policy ranked by: F (paper, exhaustive, random), F − travel_cost_per_m · F_best ·
-  // max(0, travel_m − travel_free_m) (travel), −travel_m (nearest-frontier).
+  // What the policy ranked by: F (paper, random), F + completion_weight · gain_completed_m2
+  // (exhaustive), F − travel_cost_per_m · F_best · max(0, travel_m − travel_free_m) (travel),
+  // −travel_m (nearest-frontier).
   double score = 0;
 };
 

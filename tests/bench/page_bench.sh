@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# The operator page's 3-D view with a 10 M-point map (issue 8): frame times with the level of
+# detail against drawing every point. Usage: tests/bench/page_bench.sh [MILLION_POINTS] [FRAMES]
+# after `make build` (Debian chromium, playwright-core from web/node_modules). One JSON line.
+set -euo pipefail
+src=$(cd "$(dirname "$0")/../.." && pwd)
+build=${BUILD:-$src/build}
+export SCANPLAN_SOURCE_DIR=$src
+export SCANPLAN_SERVER=$build/server/scanplan-server
+export SCANPLAN_BRIDGE=$build/scanner_bridge/scanplan-bridge
+export SCANPLAN_WEB_DIR=$src/web/dist
+export SCANPLAN_TEST_DOMAIN=${SCANPLAN_TEST_DOMAIN:-62}
+exec node "$src/tests/bench/page_bench.mjs" "${1:-10}" "${2:-8}"
