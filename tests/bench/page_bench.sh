@@ -4,10 +4,6 @@
 # after `make build` (Debian chromium, playwright-core from web/node_modules). One JSON line.
 set -euo pipefail
 src=$(cd "$(dirname "$0")/../.." && pwd)
-build=${BUILD:-$src/build}
-export SCANPLAN_SOURCE_DIR=$src
-export SCANPLAN_SERVER=$build/server/scanplan-server
-export SCANPLAN_BRIDGE=$build/scanner_bridge/scanplan-bridge
-export SCANPLAN_WEB_DIR=$src/web/dist
+. "$src/tests/bench/node_bench_env.sh"
 export SCANPLAN_TEST_DOMAIN=${SCANPLAN_TEST_DOMAIN:-62}
 exec node "$src/tests/bench/page_bench.mjs" "${1:-10}" "${2:-8}"

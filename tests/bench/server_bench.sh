@@ -4,11 +4,6 @@
 # after `make build`. Prints one JSON line (tests/bench/server_bench.mjs).
 set -euo pipefail
 src=$(cd "$(dirname "$0")/../.." && pwd)
-build=${BUILD:-$src/build}
-export SCANPLAN_SOURCE_DIR=$src
-export SCANPLAN_SERVER=$build/server/scanplan-server
-export SCANPLAN_BRIDGE=$build/scanner_bridge/scanplan-bridge
-export SCANPLAN_CLI=$build/server/scanplan
-export SCANPLAN_WEB_DIR=$src/web/dist
+. "$src/tests/bench/node_bench_env.sh"
 export SCANPLAN_TEST_DOMAIN=${SCANPLAN_TEST_DOMAIN:-61}
 exec node "$src/tests/bench/server_bench.mjs" "${1:-30}"

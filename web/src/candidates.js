@@ -1,6 +1,7 @@
 // The planner's suggestions (GET /api/v1/candidates: one plan per robot) as ranked lists, the
-// selected one's details (F, gains, drive), and the operator's decisions on it: approve, reject, cancel a move, each after
-// a confirmation (POST /api/v1/candidates/{id}/approve|reject|cancel). Viewers see no buttons.
+// selected one's details (F, gains, drive), and the operator's decisions on it: approve, reject,
+// cancel a move, each after a confirmation (POST /api/v1/candidates/{id}/approve|reject|cancel).
+// Viewers see no buttons.
 import { sendJson } from './api.js';
 import { confirmAction } from './dialog.js';
 
