@@ -1,0 +1,69 @@
+// The operator page with two robots (issue 9) at 1366×768: both robots and both plans are shown,
+// each candidate says whose it is, one robot's move is approved in the page while the other
+// robot's candidates stay approvable, and the drive shows for the robot that is driving.
+// Screenshot: $SCREENSHOT_DIR/two_robots.png.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { mkdtempSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { requestScan, startStack, worldVariant } from '../support/stack.mjs';
+import { dataset, frames, openPage, overflowing, screenshot, waitForData, withBrowser } from '../support/browser.mjs';
+
+let stack;
+before(async () => {
+  const { file } = worldVariant(mkdtempSync(join(tmpdir(), 'scanplan-two-')), 'yard.json', {
+    pose_noise: { xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
+  });
+  // Slow enough that robot1 is still driving while the page is checked (a 30 m drive: 3 s).
+  stack = await startStack({ world: file, timeScale: 20 });
+  stack.startBridge(['--robot-id', 'robot2', '--start', '22,-16,90']);
+  await stack.waitFor('both bridges', async () =>
+    (await (await stack.api('GET', '/api/v1/health', { auth: null })).json()).bridges === 2 || undefined, 20000);
+  await requestScan(stack);
+  await stack.waitFor('a plan for each robot', async () => {
+    const c = await (await stack.api('GET', '/api/v1/candidates')).json();
+    return c.plans.length === 2 && c.plans.every((p) => p.based_on_scan === 2) ? true : undefined;
+  });
+});
+after(async () => stack && (await stack.stop()));
+
+test('two robots: both plans listed by robot, each approved on its own', { timeout: 120000 }, async (t) => {
+  await withBrowser(async (context) => {
+    const { page, problems } = await openPage(context, `${stack.url}/?token=${encodeURIComponent(stack.token)}`);
+    await waitForData(page, 'both scans drawn', () => document.body.dataset.chunks === '2' && document.body.dataset.ws === 'open');
+    await waitForData(page, 'candidates of both robots', () =>
+      ['robot1', 'robot2'].every((r) => document.querySelector(`#cand-list .cand-row[data-robot="${r}"]`)));
+    const chips = await page.locator('#cand-list .cand-row .robot-chip').allInnerTexts();
+    assert.deepEqual([...new Set(chips)].sort(), ['robot1', 'robot2'], 'each row names its robot');
+    assert.match(await page.locator('#cand-summary').innerText(), /2 robots, one plan each/);
+    assert.match(await page.locator('#robots').innerText(), /robot1[\s\S]*robot2/);
+    const drawn = await page.evaluate(() => window.scanplan.topView.robots.map((r) => r.id));
+    assert.deepEqual(drawn, ['robot1', 'robot2'], 'both robots on the top view');
+    assert.deepEqual(await overflowing(page), [], 'every panel fits in 1366×768');
+
+    // Approve robot1's best in the page, with the confirmation naming robot1.
+    await page.locator('#cand-list .cand-row[data-robot="robot1"]').first().click();
+    await page.click('#approve');
+    await page.waitForSelector('#confirm[open]');
+    assert.match(await page.locator('#confirm-body').innerText(), /^robot1 will drive/);
+    await page.click('#confirm-ok');
+    await waitForData(page, 'robot1 driving', () =>
+      document.querySelector('#cand-list .cand-row[data-robot="robot1"][data-state="moving"]'));
+
+    // robot2's candidates can still be approved while robot1 drives; robot1's others cannot.
+    await page.locator('#cand-list .cand-row[data-robot="robot2"][data-state="proposed"]').first().click();
+    assert.equal(await page.locator('#approve').isDisabled(), false, 'robot2 is free');
+    const other1 = page.locator('#cand-list .cand-row[data-robot="robot1"][data-state="proposed"]');
+    if (await other1.count()) {
+      await other1.first().click();
+      assert.equal(await page.locator('#approve').isDisabled(), true, 'robot1 is driving');
+      assert.match(await page.locator('#approve').getAttribute('title'), /robot1 is still driving/);
+    }
+    await frames(page);
+    t.diagnostic(`shot: ${await screenshot(page, 'two_robots.png')}`);
+    const ds = await dataset(page);
+    assert.equal(ds.error, '');
+    assert.deepEqual(problems, { pageErrors: [], consoleErrors: [], foreignRequests: [] }, 'no page errors, nothing from elsewhere');
+  });
+});
