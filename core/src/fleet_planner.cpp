@@ -19,8 +19,14 @@ std::vector<FleetPlan> plan_fleet(const MlsMap& map, const TargetRegion& target,
     std::vector<Plan> plans;
     plans.reserve(open.size());
     for (const FleetRobot& r : open) {
+      // The other robots stand where they are until they are sent somewhere.
+      std::vector<Eigen::Vector3d> others;
+      for (const FleetRobot& o : robots) {
+        if (o.id != r.id) others.push_back(o.position);
+      }
       PlanInput in{map, target, scan_points, r.position};
       in.claimed = &claimed;
+      in.occupied = &others;
       plans.push_back(plan_next_scan(in, cfg));
     }
     // The highest best score; then, among those close to it, the shortest drive.

@@ -66,6 +66,7 @@ void check_config(const PlannerConfig& c) {
   if (!(c.travel_free_m >= 0)) fail("travel_free_m must be zero or more");
   if (!(c.candidate_separation_m >= 0)) fail("candidate_separation_m must be zero or more");
   if (!(c.claim_separation_m >= 0)) fail("claim_separation_m must be zero or more");
+  if (!(c.robot_clearance_m >= 0)) fail("robot_clearance_m must be zero or more");
   if (!std::isfinite(c.min_gain_m2)) fail("min_gain_m2 must be finite");
   if (c.threads < 0) fail("threads must be zero (OpenMP default) or more");
 }
@@ -112,21 +113,40 @@ struct Sites {
   }
 };
 
-// The other robots' claimed scan points, checked: each must be finite.
-const std::vector<Eigen::Vector3d>& claims_of(const PlanInput& in) {
+// Points of the other robots (claimed goals, where they stand), checked: each must be finite.
+const std::vector<Eigen::Vector3d>& points_of(const std::vector<Eigen::Vector3d>* points,
+                                              const char* what) {
   static const std::vector<Eigen::Vector3d> kNone;
-  if (!in.claimed) return kNone;
-  for (const Eigen::Vector3d& c : *in.claimed) {
-    if (!c.allFinite())
-      throw std::invalid_argument("plan_next_scan: a claimed point is not finite");
+  if (!points) return kNone;
+  for (const Eigen::Vector3d& c : *points) {
+    if (!c.allFinite()) throw std::invalid_argument(std::string("plan_next_scan: ") + what);
   }
-  return *in.claimed;
+  return *points;
+}
+const std::vector<Eigen::Vector3d>& claims_of(const PlanInput& in) {
+  return points_of(in.claimed, "a claimed point is not finite");
+}
+
+// A disc no candidate may lie in: around another robot's goal, or around another robot.
+struct KeepOut {
+  Eigen::Vector2d centre;
+  double radius2;
+};
+
+std::vector<KeepOut> keep_outs(const PlanInput& in, const PlannerConfig& cfg) {
+  std::vector<KeepOut> out;
+  for (const Eigen::Vector3d& c : claims_of(in)) {
+    out.push_back({c.head<2>(), cfg.claim_separation_m * cfg.claim_separation_m});
+  }
+  for (const Eigen::Vector3d& r :
+       points_of(in.occupied, "another robot's position is not finite")) {
+    out.push_back({r.head<2>(), cfg.robot_clearance_m * cfg.robot_clearance_m});
+  }
+  return out;
 }
 
 Sites collect_sites(const MlsMap& map, const MovableRegion& movable, const TravelMap& travel,
-                    const TargetRegion* within, const std::vector<Eigen::Vector3d>& claims,
-                    double claim_separation_m) {
-  const double claim_sep2 = claim_separation_m * claim_separation_m;
+                    const TargetRegion* within, const std::vector<KeepOut>& keep_out) {
   Sites s;
   const auto& g = movable.patch;
   s.index = CellGrid<std::int32_t>(g.origin, g.cols, g.rows, g.cell_m, -1);
@@ -138,9 +158,9 @@ Sites collect_sites(const MlsMap& map, const MovableRegion& movable, const Trave
     // The robot may start outside the target region, but it scans only inside.
     const Eigen::Vector2d centre = map.center_of(c);
     if (within && !within->contains(centre.x(), centre.y())) continue;
-    // Another robot is going there.
-    if (std::any_of(claims.begin(), claims.end(), [&](const Eigen::Vector3d& c) {
-          return (c.head<2>() - centre).squaredNorm() < claim_sep2;
+    // Another robot is going there, or standing there.
+    if (std::any_of(keep_out.begin(), keep_out.end(), [&](const KeepOut& k) {
+          return (k.centre - centre).squaredNorm() < k.radius2;
         })) {
       continue;
     }
@@ -438,6 +458,7 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
   if (!in.robot.allFinite())
     throw std::invalid_argument("plan_next_scan: the robot position is not finite");
   const std::vector<Eigen::Vector3d>& claims = claims_of(in);
+  keep_outs(in, cfg);  // checks the other robots' positions before any work
   const auto t0 = std::chrono::steady_clock::now();
   Plan plan;
   const auto finish = [&]() -> Plan {
@@ -463,9 +484,8 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
 
   const TravelMap travel = travel_map(in.map, plan.movable, start, cfg.movable,
                                       cfg.stay_in_target ? &in.target : nullptr);
-  const Sites sites =
-      collect_sites(in.map, plan.movable, travel, cfg.stay_in_target ? &in.target : nullptr, claims,
-                    cfg.claim_separation_m);
+  const Sites sites = collect_sites(in.map, plan.movable, travel,
+                                    cfg.stay_in_target ? &in.target : nullptr, keep_outs(in, cfg));
   if (sites.size() == 0) return finish();
   // With claims, F is taken against the segmentation as it will be after the other robots'
   // scans; plan.regions stays the map's own.

@@ -350,6 +350,26 @@ TEST_F(WallYard, ClaimingAScanMarksWhatItWouldSeeAsSegmentationWould) {
   EXPECT_EQ(claim_predicted_scans(regions, predictor, {{900, 900, 0}}, cfg.regions), 0u);
 }
 
+// A robot standing on the best spot keeps the others' candidates a footprint away from it.
+TEST_F(WallYard, NoCandidateWhereAnotherRobotStands) {
+  PlannerConfig cfg;
+  cfg.policy = PlannerPolicy::kExhaustive;
+  const Candidate best = plan_next_scan(input(), cfg).ranked.front();
+  const std::vector<Eigen::Vector3d> standing = {best.position};
+  PlanInput in = input();
+  in.occupied = &standing;
+  const Plan plan = plan_next_scan(in, cfg);
+  ASSERT_FALSE(plan.ranked.empty());
+  for (const Candidate& c : plan.ranked) {
+    EXPECT_GE((c.position - best.position).head<2>().norm(), cfg.robot_clearance_m);
+  }
+  // Only a footprint: the next best is still right there, past the wall.
+  EXPECT_TRUE(past_the_wall(plan.ranked.front())) << plan.ranked.front().position.transpose();
+  const std::vector<Eigen::Vector3d> nowhere = {{std::nan(""), 0, 0}};
+  in.occupied = &nowhere;
+  EXPECT_THROW(plan_next_scan(in, cfg), std::invalid_argument);
+}
+
 TEST_F(WallYard, ANonFiniteClaimIsRefused) {
   const std::vector<Eigen::Vector3d> claimed = {{std::nan(""), 1, 0}};
   PlanInput in = input();

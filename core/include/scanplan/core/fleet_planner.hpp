@@ -25,7 +25,8 @@ struct FleetPlan {
 // yet decided is planned, and the robot whose best candidate scores highest is decided; when
 // several score within PlannerConfig::fleet_tie_share of the highest, often the same spot seen
 // from different robots, the one with the shortest drive to its own takes it, so robots do not
-// cross the site to each other's side. With one robot this is plan_next_scan. Returns the plans
+// cross the site to each other's side. No robot's candidate lies where another robot stands
+// (PlanInput::occupied). With one robot this is plan_next_scan. Returns the plans
 // in the order decided; a robot whose plan is empty is decided last.
 std::vector<FleetPlan> plan_fleet(const MlsMap& map, const TargetRegion& target,
                                   const std::vector<Eigen::Vector2d>& scan_points,

@@ -67,6 +67,9 @@ struct PlannerConfig {
   // paper's 20 m completed radius (§3.3): nearer than that, two scans mostly complete the same
   // ground, which the claimed gains already discount.
   double claim_separation_m = 10.0;
+  // ...and none this close to where another robot stands (PlanInput::occupied): a robot's
+  // footprint with a margin.
+  double robot_clearance_m = 2.0;
   // Several robots (plan_fleet): best candidates scoring within this share of the highest
   // count as equally good, and the robot with the shortest drive to its own takes it.
   double fleet_tie_share = 0.02;
@@ -106,6 +109,8 @@ struct PlanInput {
   // already taken: U it would see becomes M or C, M it would see within the completed radius
   // becomes C, as segment_regions would have it after that scan. Null or empty: one robot.
   const std::vector<Eigen::Vector3d>* claimed = nullptr;
+  // Where the other robots stand now (x, y, floor z): no candidate within robot_clearance_m.
+  const std::vector<Eigen::Vector3d>* occupied = nullptr;
 };
 
 struct Plan {
