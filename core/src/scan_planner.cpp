@@ -458,7 +458,7 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
   if (!in.robot.allFinite())
     throw std::invalid_argument("plan_next_scan: the robot position is not finite");
   const std::vector<Eigen::Vector3d>& claims = claims_of(in);
-  keep_outs(in, cfg);  // checks the other robots' positions before any work
+  const std::vector<KeepOut> keep_out = keep_outs(in, cfg);
   const auto t0 = std::chrono::steady_clock::now();
   Plan plan;
   const auto finish = [&]() -> Plan {
@@ -485,7 +485,7 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
   const TravelMap travel = travel_map(in.map, plan.movable, start, cfg.movable,
                                       cfg.stay_in_target ? &in.target : nullptr);
   const Sites sites = collect_sites(in.map, plan.movable, travel,
-                                    cfg.stay_in_target ? &in.target : nullptr, keep_outs(in, cfg));
+                                    cfg.stay_in_target ? &in.target : nullptr, keep_out);
   if (sites.size() == 0) return finish();
   // With claims, F is taken against the segmentation as it will be after the other robots'
   // scans; plan.regions stays the map's own.

@@ -495,13 +495,8 @@ Response Api::post_goal(const Request& request) {
     robot = body["robot"].get<std::string>();
   }
   try {
-    const CandidateRecord c = mission_.propose(x, y, robot, decided_by(body));
-    for (const PlanRecord& p : store_.plans()) {
-      for (const CandidateRecord& k : p.candidates) {
-        if (k.id == c.id) return Response::json(201, candidate_json(c, p.robot, p.id));
-      }
-    }
-    return Response::json(201, candidate_json(c, robot, 0));
+    const Mission::Proposed p = mission_.propose(x, y, robot, decided_by(body));
+    return Response::json(201, candidate_json(p.candidate, p.robot, p.plan));
   } catch (const MissionError& e) {
     throw HttpError(e.status, e.code, e.what());
   }

@@ -144,8 +144,8 @@ json Mission::cancel(std::uint64_t id, const std::string& by) {
   return out;
 }
 
-CandidateRecord Mission::propose(double x, double y, const std::string& robot,
-                                 const std::string& by) {
+Mission::Proposed Mission::propose(double x, double y, const std::string& robot,
+                                   const std::string& by) {
   // Not under mutex_: add_goal may wait for a scan being brought into the map, and the DDS
   // thread's on_status must not wait that long.
   const auto plan = store_.plan(robot);
@@ -168,7 +168,7 @@ CandidateRecord Mission::propose(double x, double y, const std::string& robot,
                   {"f", c.candidate.f},
                   {"travel_m", c.candidate.travel_m},
                   {"by", by}});
-  return c;
+  return {c, plan->robot, plan->id};
 }
 
 json Mission::log(std::size_t limit) const {

@@ -34,10 +34,15 @@ class Mission {
   nlohmann::json reject(std::uint64_t candidate, const std::string& by, const std::string& reason);
   // Stops an approved move where the robot now is.
   nlohmann::json cancel(std::uint64_t candidate, const std::string& by);
-  // The operator's own scan point: added to the current plan as a custom candidate (to be
-  // approved like the planner's), recorded as "goal". `robot` empty: the plan's robot.
+  // The operator's own scan point: added to `robot`'s plan (empty: the robot whose scan came
+  // last) as a custom candidate (to be approved like the planner's), recorded as "goal".
   // Throws MissionError 400 naming why the robot cannot go there, 409 before the first plan.
-  CandidateRecord propose(double x, double y, const std::string& robot, const std::string& by);
+  struct Proposed {
+    CandidateRecord candidate;
+    std::string robot;
+    std::uint64_t plan = 0;  // the plan it was added to
+  };
+  Proposed propose(double x, double y, const std::string& robot, const std::string& by);
   // The newest `limit` recorded decisions, oldest first: {"id","at","kind",...details}.
   nlohmann::json log(std::size_t limit) const;
   // From the DDS thread.

@@ -115,13 +115,12 @@ void ScanStore::add(const StoredScan& scan, const PointCloud& cloud) {
 
 namespace {
 
-// A robot is carrying out an approved move to this candidate.
-bool is_active_goal(const CandidateRecord& c) {
-  return c.state == "moving";
-}
-
-Eigen::Vector3d floor_point(const CandidateRecord& c) {
-  return c.candidate.position;
+// The candidate the plan's robot is driving to (an approved move under way), if any.
+const CandidateRecord* active_goal(const PlanRecord& plan) {
+  for (const CandidateRecord& c : plan.candidates) {
+    if (c.state == "moving") return &c;
+  }
+  return nullptr;
 }
 
 }  // namespace
@@ -130,16 +129,11 @@ std::vector<Eigen::Vector3d> ScanStore::claims_except(const std::string& robot) 
   std::vector<Eigen::Vector3d> claims;
   for (const auto& [id, plan] : plans_) {
     if (id == robot) continue;
-    const CandidateRecord* goal = nullptr;
+    const CandidateRecord* goal = active_goal(plan);
     for (const CandidateRecord& c : plan.candidates) {
-      if (is_active_goal(c)) goal = &c;
+      if (!goal && c.state == "proposed" && c.rank == 1) goal = &c;
     }
-    if (!goal) {
-      for (const CandidateRecord& c : plan.candidates) {
-        if (c.state == "proposed" && c.rank == 1) goal = &c;
-      }
-    }
-    if (goal) claims.push_back(floor_point(*goal));
+    if (goal) claims.push_back(goal->candidate.position);
   }
   return claims;
 }
@@ -163,9 +157,8 @@ std::vector<PlanRecord> ScanStore::refresh_derived(const std::function<void()>& 
   {
     std::lock_guard lock(mutex_);
     for (const auto& [robot, plan] : plans_) {
-      for (const CandidateRecord& c : plan.candidates) {
-        if (!is_active_goal(c)) continue;
-        claims.push_back(floor_point(c));
+      if (const CandidateRecord* goal = active_goal(plan)) {
+        claims.push_back(goal->candidate.position);
         driving.insert(robot);
       }
     }
