@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "replay_robot.hpp"
-#include "scanplan/core/ray_caster.hpp"
-#include "scanplan/core/world_traversability.hpp"
 #include "scanplan/msgs/dds_participant.hpp"
+#include "scanplan/sim/ray_caster.hpp"
+#include "scanplan/sim/world_traversability.hpp"
 #include "simulated_robot.hpp"
 
 namespace {

@@ -5,7 +5,7 @@
 #include <fstream>
 #include <thread>
 
-#include "scanplan/core/image_codec.hpp"
+#include "scanplan/io/image_codec.hpp"
 
 namespace scanplan::bridge {
 namespace {

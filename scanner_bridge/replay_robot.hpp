@@ -5,7 +5,7 @@
 
 #include "command_reader.hpp"
 #include "scanner_publisher.hpp"
-#include "scanplan/core/replay_folder.hpp"
+#include "scanplan/io/replay_folder.hpp"
 
 namespace scanplan::bridge {
 

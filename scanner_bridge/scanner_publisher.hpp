@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "scanplan/core/panorama_camera.hpp"
-#include "scanplan/core/point_cloud.hpp"
-#include "scanplan/core/pose.hpp"
+#include "scanplan/geometry/panorama_camera.hpp"
+#include "scanplan/geometry/point_cloud.hpp"
+#include "scanplan/geometry/pose.hpp"
 #include "scanplan/msgs/dds_participant.hpp"
 
 namespace scanplan::bridge {

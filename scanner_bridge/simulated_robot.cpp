@@ -6,8 +6,8 @@
 #include <cmath>
 #include <thread>
 
-#include "scanplan/core/image_codec.hpp"
-#include "scanplan/core/simulated_shot.hpp"
+#include "scanplan/io/image_codec.hpp"
+#include "scanplan/sim/simulated_shot.hpp"
 
 namespace scanplan::bridge {
 

@@ -7,9 +7,9 @@
 
 #include "command_reader.hpp"
 #include "scanner_publisher.hpp"
-#include "scanplan/core/ray_caster.hpp"
-#include "scanplan/core/world.hpp"
-#include "scanplan/core/world_traversability.hpp"
+#include "scanplan/sim/ray_caster.hpp"
+#include "scanplan/sim/world.hpp"
+#include "scanplan/sim/world_traversability.hpp"
 
 namespace scanplan::bridge {
 

@@ -9,9 +9,10 @@
 #include <utility>
 #include <vector>
 
-#include "scanplan/core/pose.hpp"
-#include "scanplan/core/registration.hpp"
-#include "scanplan/core/scan_file.hpp"
+#include "scanplan/geometry/pose.hpp"
+#include "scanplan/io/scan_file.hpp"
+#include "scanplan/registration/registration.hpp"
+#include "scanplan/registration_pcl/pcl_registration.hpp"
 
 namespace scanplan::cli {
 namespace {
@@ -46,7 +47,7 @@ PointCloud read_scan(const std::string& file, const char* role, const RegisterAr
 }
 
 void run_register(const RegisterArgs& a) {
-  const std::optional<Method> method = parse_method(a.method);
+  const std::optional<AnyMethod> method = parse_any_method(a.method);
   if (!method) {
     throw std::runtime_error("--method " + a.method +
                              ": expected ndt-icp, ndt, icp, pcl-ndt, pcl-icp or pcl-gicp");
@@ -62,7 +63,7 @@ void run_register(const RegisterArgs& a) {
   }
   RegistrationConfig config;
   config.dof = a.dof == 6 ? Dof::k6 : Dof::k4;
-  const RegistrationResult r = register_scans(target, source, init.isometry(), *method, config);
+  const RegistrationResult r = register_any(target, source, init.isometry(), *method, config);
 
   const Pose p = Pose::from_isometry(r.transform);
   // ordered_json keeps the keys in DESIGN.md's order, which reads better than sorted.

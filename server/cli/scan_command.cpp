@@ -6,9 +6,9 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "scanplan/core/colorizer.hpp"
-#include "scanplan/core/ply_io.hpp"
-#include "scanplan/core/simulated_shot.hpp"
+#include "scanplan/io/ply_io.hpp"
+#include "scanplan/mapping/colorizer.hpp"
+#include "scanplan/sim/simulated_shot.hpp"
 
 namespace scanplan::cli {
 namespace {

@@ -8,9 +8,9 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "scanplan/core/closed_loop.hpp"
-#include "scanplan/core/coverage_chart.hpp"
-#include "scanplan/core/plan_view.hpp"
+#include "scanplan/experiments/closed_loop.hpp"
+#include "scanplan/experiments/coverage_chart.hpp"
+#include "scanplan/planning/plan_view.hpp"
 
 namespace scanplan::cli {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "dds_link.hpp"
 #include "events.hpp"
-#include "scanplan/core/session_store.hpp"
+#include "storage/session_store.hpp"
 
 namespace scanplan::server {
 

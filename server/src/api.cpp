@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "http/http_error.hpp"
-#include "scanplan/core/scan_file.hpp"
+#include "scanplan/io/scan_file.hpp"
 
 namespace scanplan::server {
 

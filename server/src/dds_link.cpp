@@ -8,8 +8,8 @@
 
 #include "ros2_types.h"
 #include "scanplan.h"
-#include "scanplan/core/colorizer.hpp"
-#include "scanplan/core/image_codec.hpp"
+#include "scanplan/io/image_codec.hpp"
+#include "scanplan/mapping/colorizer.hpp"
 #include "scanplan/msgs/camera_info.hpp"
 #include "scanplan/msgs/pointcloud2.hpp"
 #include "scanplan/msgs/pose_array.hpp"

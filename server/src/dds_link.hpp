@@ -17,8 +17,8 @@
 #include "events.hpp"
 #include "scan_intake.hpp"
 #include "scan_store.hpp"
-#include "scanplan/core/panorama_camera.hpp"
-#include "scanplan/core/point_cloud.hpp"
+#include "scanplan/geometry/panorama_camera.hpp"
+#include "scanplan/geometry/point_cloud.hpp"
 #include "scanplan/msgs/dds_participant.hpp"
 
 namespace scanplan::server {

@@ -7,9 +7,8 @@
 
 namespace scanplan::server {
 
-ScanIntake::ScanIntake(SessionStore& session, ScanStore& live, const Events& events,
-                       std::optional<MapMatchConfig> matching)
-    : session_(session), live_(live), events_(events), matching_(std::move(matching)) {}
+ScanIntake::ScanIntake(SessionStore& session, ScanStore& live, const Events& events)
+    : session_(session), live_(live), events_(events) {}
 
 ScanIntake::~ScanIntake() {
   stop();
@@ -64,10 +63,9 @@ StoredScan ScanIntake::submit(const std::string& robot, const Pose& estimated,
 }
 
 StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
-  if (!matching_ || live_.scan_count() == 0) return scan;
-  const MapMatch m = match_to_map(
-      live_.points_near(scan.estimated.x, scan.estimated.y, matching_->target_radius_m), cloud,
-      scan.estimated, *matching_);
+  const std::optional<MapMatch> matched = live_.place(cloud, scan.estimated);
+  if (!matched) return scan;
+  const MapMatch& m = *matched;
   const Pose& e = scan.estimated;
   const Pose& p = m.placed;
   events_.publish("match_done",

@@ -9,8 +9,7 @@
 
 #include "events.hpp"
 #include "scan_store.hpp"
-#include "scanplan/core/map_matcher.hpp"
-#include "scanplan/core/session_store.hpp"
+#include "storage/session_store.hpp"
 
 namespace scanplan::server {
 
@@ -19,8 +18,7 @@ namespace scanplan::server {
 // so neither the network thread nor the DDS thread waits on the map, the layers or Draco.
 class ScanIntake {
  public:
-  ScanIntake(SessionStore& session, ScanStore& live, const Events& events,
-             std::optional<MapMatchConfig> matching = MapMatchConfig{});
+  ScanIntake(SessionStore& session, ScanStore& live, const Events& events);
   ~ScanIntake();
   ScanIntake(const ScanIntake&) = delete;
   ScanIntake& operator=(const ScanIntake&) = delete;
@@ -46,7 +44,6 @@ class ScanIntake {
   SessionStore& session_;
   ScanStore& live_;
   const Events& events_;
-  std::optional<MapMatchConfig> matching_;  // nothing: scans go where the robot says they are
   mutable std::mutex mutex_;
   std::condition_variable wake_;
   std::deque<std::pair<StoredScan, PointCloud>> queue_;

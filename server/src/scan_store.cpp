@@ -5,11 +5,11 @@
 #include <cstdio>
 #include <set>
 
-#include "scanplan/core/draco_codec.hpp"
-#include "scanplan/core/fleet_planner.hpp"
-#include "scanplan/core/movable_region.hpp"
-#include "scanplan/core/top_view.hpp"
-#include "scanplan/core/travel_map.hpp"
+#include "scanplan/compression/draco_codec.hpp"
+#include "scanplan/mapping/movable_region.hpp"
+#include "scanplan/mapping/top_view.hpp"
+#include "scanplan/planning/fleet_planner.hpp"
+#include "scanplan/planning/travel_map.hpp"
 
 namespace scanplan::server {
 
@@ -20,10 +20,9 @@ double approach_yaw_deg(const Candidate& c) {
   return rad2deg(std::atan2(d.y(), d.x()));
 }
 
-ScanStore::ScanStore(PipelineConfig pipeline, PlannerConfig planner)
-    : pipeline_(pipeline),
-      planner_(planner),
-      claim_separation_m_(planner.claim_separation_m),
+ScanStore::ScanStore(MissionConfig config)
+    : mission_(std::move(config)),
+      claim_separation_m_(mission_.planner().claim_separation_m),
       encoder_([this] { encode_loop(); }) {}
 
 ScanStore::~ScanStore() {
@@ -72,26 +71,22 @@ const std::vector<std::string>& ScanStore::layer_names() {
   return kNames;
 }
 
+std::optional<MapMatch> ScanStore::place(const PointCloud& scan, const Pose& reported) const {
+  std::lock_guard encode_lock(encode_mutex_);
+  return mission_.place(scan, reported);
+}
+
 void ScanStore::add(const StoredScan& scan, const PointCloud& cloud) {
   const Pose& pose = scan.placed;
-  const Eigen::Affine3f map_from_robot = pose.isometry().cast<float>();
-  PointCloud placed;
-  placed.reserve(cloud.size());
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    placed.push_back(map_from_robot * cloud.points[i],
-                     cloud.has_colors() ? cloud.colors[i] : Rgb{128, 128, 128});
-  }
-
   // Writers take turns on encode_mutex_; readers only wait for the short commit below, and
   // they see the scan, its points, its chunk and the plan that includes it appear together.
-  const Bounds3 added = bounds_of(placed);
   std::lock_guard encode_lock(encode_mutex_);
+  std::shared_ptr<const PointCloud> shared = mission_.add(cloud, pose);
+  const Bounds3 added = bounds_of(*shared);
   std::shared_ptr<const std::string> chunk;
-  if (!placed.empty()) chunk = std::make_shared<const std::string>(encode_draco(placed));
-  auto shared = std::make_shared<const PointCloud>(std::move(placed));
+  if (!shared->empty()) chunk = std::make_shared<const std::string>(encode_draco(*shared));
 
   thinned_.add(*shared);
-  pipeline_.add_scan(cloud, pose);
   last_scan_ = {scan.id, scan.robot};
   scan_pose_of_[scan.robot] = pose;
   const auto plans = refresh_derived([&] {
@@ -139,14 +134,15 @@ std::vector<Eigen::Vector3d> ScanStore::claims_except(const std::string& robot) 
 }
 
 std::vector<PlanRecord> ScanStore::refresh_derived(const std::function<void()>& commit) {
-  if (!pipeline_.regions() || !pipeline_.movable()) {
+  const MappingPipeline& mapping = mission_.mapping();
+  if (!mission_.has_map()) {
     std::lock_guard lock(mutex_);
     if (commit) commit();
     return {};
   }
-  const RegionMap& regions = *pipeline_.regions();
-  const MovableRegion& movable = *pipeline_.movable();
-  const std::vector<Eigen::Vector2d> points = pipeline_.scan_points();
+  const RegionMap& regions = *mapping.regions();
+  const MovableRegion& movable = *mapping.movable();
+  const std::vector<Eigen::Vector2d> points = mapping.scan_points();
 
   // Several robots share the map: they are decided one after another (plan_fleet), each
   // counting what the robots before it will scan as taken (PlanInput::claimed), so no two are
@@ -168,8 +164,8 @@ std::vector<PlanRecord> ScanStore::refresh_derived(const std::function<void()>& 
     if (!driving.count(robot)) robots.push_back({robot, {at.x, at.y, at.z}});
   }
   std::vector<PlanRecord> records;
-  for (FleetPlan& decided : plan_fleet(pipeline_.map(), *pipeline_.target(), points, robots,
-                                       std::move(claims), planner_)) {
+  const PlannerConfig& planner = mission_.planner();
+  for (FleetPlan& decided : mission_.plan(robots, std::move(claims))) {
     const Plan& plan = decided.plan;
     PlanRecord record;
     record.id = next_plan_id_++;
@@ -182,8 +178,8 @@ std::vector<PlanRecord> ScanStore::refresh_derived(const std::function<void()>& 
       c.candidate = plan.ranked[k];
       record.candidates.push_back(std::move(c));
     }
-    record.policy = std::string(policy_name(planner_.policy));
-    record.alpha = planner_.alpha;
+    record.policy = std::string(policy_name(planner.policy));
+    record.alpha = planner.alpha;
     record.plan_ms = plan.plan_ms;
     records.push_back(std::move(record));
   }
@@ -199,8 +195,8 @@ std::vector<PlanRecord> ScanStore::refresh_derived(const std::function<void()>& 
   // The candidates are not drawn in: clients draw them over the layer (the page does, with
   // their states), and the layer stays the paper's Fig. 4/5.
   layers["regions"] = png(render_regions(regions, &movable, points));
-  layers["elevation"] = png(render_elevation(pipeline_.map(), regions));
-  layers["movable"] = png(render_movable(pipeline_.map(), movable, regions));
+  layers["elevation"] = png(render_elevation(mapping.map(), regions));
+  layers["movable"] = png(render_movable(mapping.map(), movable, regions));
   const MapAreas areas{regions.completed_m2(), regions.low_resolution_m2(), regions.unscanned_m2(),
                        movable.area_m2()};
   // The layers' pixels in the map, as top_view_pixel places them.
@@ -276,19 +272,19 @@ CandidateRecord ScanStore::add_goal(double x, double y, const std::string& robot
     }
     claims = claims_except(robot);
   }
-  if (!pipeline_.regions() || !pipeline_.movable() || !pipeline_.target() ||
-      pipeline_.scan_poses().empty()) {
+  const MappingPipeline& mapping = mission_.mapping();
+  if (!mission_.has_map() || mapping.scan_poses().empty()) {
     throw GoalRefused("no_map", "there is no map yet: take a first scan");
   }
-  const MlsMap& map = pipeline_.map();
-  const TargetRegion& target = *pipeline_.target();
+  const PlannerConfig& planner = mission_.planner();
+  const MlsMap& map = mapping.map();
+  const TargetRegion& target = *mapping.target();
   const Pose at = scan_pose_of_.at(robot);
   const Eigen::Vector3d from(at.x, at.y, at.z);
   // The region this robot can reach, flooded from where it stands (the pipeline's is the last
   // scanning robot's, and two robots may stand in parts of the site apart from each other).
-  const MovableRegion movable = robot == last_scan_.second
-                                    ? *pipeline_.movable()
-                                    : movable_region(map, from, planner_.movable);
+  const MovableRegion movable =
+      robot == last_scan_.second ? *mapping.movable() : movable_region(map, from, planner.movable);
   char where[64];
   std::snprintf(where, sizeof where, "(%.1f, %.1f)", x, y);
   if (!target.contains(x, y)) {
@@ -306,11 +302,11 @@ CandidateRecord ScanStore::add_goal(double x, double y, const std::string& robot
     std::snprintf(why, sizeof why,
                   " is not in the movable region: no floor the robot can reach there (a step "
                   "over %.2f m, an obstacle or too little headroom)",
-                  planner_.movable.max_step_m);
+                  planner.movable.max_step_m);
     throw GoalRefused("not_movable", where + std::string(why));
   }
   const TravelMap travel =
-      travel_map(map, movable, from, planner_.movable, planner_.stay_in_target ? &target : nullptr);
+      travel_map(map, movable, from, planner.movable, planner.stay_in_target ? &target : nullptr);
   if (!travel.reachable(cell)) {
     throw GoalRefused("unreachable", std::string(where) +
                                          " is movable but no drive inside the target region "
@@ -319,11 +315,11 @@ CandidateRecord ScanStore::add_goal(double x, double y, const std::string& robot
   const auto offset = movable.patch.offset(cell);
   const float floor_z = map.cell(cell)->patches[movable.patch.values[*offset]].mean_z;
   const Eigen::Vector2d centre = map.center_of(cell);
-  const std::vector<Eigen::Vector2d> points = pipeline_.scan_points();
+  const std::vector<Eigen::Vector2d> points = mapping.scan_points();
   CandidateRecord record;
   PlanInput input{map, target, points, from};
   input.claimed = &claims;
-  evaluate(input, planner_, {centre.x(), centre.y(), floor_z}, &record.candidate);
+  evaluate(input, planner, {centre.x(), centre.y(), floor_z}, &record.candidate);
   record.candidate.travel_m = travel.distance(cell);
   record.candidate.path = travel.path_to(cell);
   record.id = next_candidate_id_++;
@@ -346,32 +342,18 @@ bool ScanStore::set_candidate_state(std::uint64_t id, const std::string& state,
 
 MissionParams ScanStore::params() const {
   std::lock_guard lock(encode_mutex_);
-  return {planner_, pipeline_.target()};
+  return {mission_.planner(), mission_.mapping().target()};
 }
 
 void ScanStore::set_params(const MissionParams& params) {
   std::lock_guard encode_lock(encode_mutex_);
-  planner_ = params.planner;
   claim_separation_m_ = params.planner.claim_separation_m;
-  pipeline_.set_region_configs(params.planner.regions, params.planner.movable);
-  if (params.target) pipeline_.set_target(*params.target);
+  mission_.set_planner(params.planner);
+  if (params.target) mission_.set_target(*params.target);
   const auto plans = refresh_derived({});
   if (on_plan) {
     for (const PlanRecord& plan : plans) on_plan(plan);
   }
-}
-
-PointCloud ScanStore::points_near(double x, double y, double radius_m) const {
-  std::lock_guard lock(mutex_);
-  PointCloud out;
-  const Eigen::Vector2f c(static_cast<float>(x), static_cast<float>(y));
-  const float r2 = static_cast<float>(radius_m * radius_m);
-  for (const auto& part : placed_) {
-    for (const auto& p : part->points) {
-      if ((p.head<2>() - c).squaredNorm() <= r2) out.points.push_back(p);
-    }
-  }
-  return out;
 }
 
 std::vector<StoredScan> ScanStore::scans() const {

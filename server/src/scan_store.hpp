@@ -14,12 +14,12 @@
 #include <thread>
 #include <vector>
 
-#include "scanplan/core/mapping_pipeline.hpp"
-#include "scanplan/core/point_cloud.hpp"
-#include "scanplan/core/pose.hpp"
-#include "scanplan/core/scan_planner.hpp"
-#include "scanplan/core/session_store.hpp"
-#include "scanplan/core/voxel_filter.hpp"
+#include "scanplan/geometry/point_cloud.hpp"
+#include "scanplan/geometry/pose.hpp"
+#include "scanplan/geometry/voxel_filter.hpp"
+#include "scanplan/mission/mission_pipeline.hpp"
+#include "scanplan/planning/scan_planner.hpp"
+#include "storage/session_store.hpp"
 
 namespace scanplan::server {
 
@@ -116,7 +116,7 @@ struct MissionParams {
 // of its own after the scan is published: new candidates never wait for it.
 class ScanStore {
  public:
-  explicit ScanStore(PipelineConfig pipeline = {}, PlannerConfig planner = {});
+  explicit ScanStore(MissionConfig config = {});
   ~ScanStore();
   ScanStore(const ScanStore&) = delete;
   ScanStore& operator=(const ScanStore&) = delete;
@@ -139,8 +139,9 @@ class ScanStore {
   void add(const StoredScan& scan, const PointCloud& cloud);
 
   std::vector<StoredScan> scans() const;
-  // The map's points (map frame) within `radius_m` of (x, y) in the x-y plane.
-  PointCloud points_near(double x, double y, double radius_m) const;
+  // Where a new scan goes: matched against the map so far (MissionPipeline::place). Nothing when
+  // matching is off or the map is empty. Call from the thread that calls add().
+  std::optional<MapMatch> place(const PointCloud& scan, const Pose& reported) const;
   std::size_t scan_count() const;
   std::optional<StoredScan> last_scan() const;
   std::size_t point_count() const;
@@ -214,8 +215,7 @@ class ScanStore {
   MapAreas areas_;
   std::map<std::int64_t, MapAreas> areas_after_;  // by scan id
   std::optional<LayerGeometry> layer_geometry_;
-  MappingPipeline pipeline_;                        // written only under encode_mutex_
-  PlannerConfig planner_;                           // written only under encode_mutex_
+  MissionPipeline mission_;                         // written only under encode_mutex_
   std::pair<std::int64_t, std::string> last_scan_;  // id and robot; under encode_mutex_
   std::map<std::string, Pose> scan_pose_of_;  // each robot's last scan pose; under encode_mutex_
   std::uint64_t next_plan_id_ = 1, next_candidate_id_ = 1;  // under encode_mutex_

@@ -8,10 +8,10 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "scanplan/core/colorizer.hpp"
-#include "scanplan/core/draco_codec.hpp"
-#include "scanplan/core/simulated_shot.hpp"
-#include "scanplan/core/world.hpp"
+#include "scanplan/compression/draco_codec.hpp"
+#include "scanplan/mapping/colorizer.hpp"
+#include "scanplan/sim/simulated_shot.hpp"
+#include "scanplan/sim/world.hpp"
 
 int main(int argc, char** argv) {
   using namespace scanplan;

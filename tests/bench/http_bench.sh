@@ -24,7 +24,7 @@ trap cleanup EXIT
 token=$(head -c 16 /dev/urandom | od -An -tx1 | tr -d ' \n')
 export CYCLONEDDS_URI='<CycloneDDS><Domain Id="any"><General><Interfaces><NetworkInterface address="127.0.0.1" multicast="true"/></Interfaces></General></Domain></CycloneDDS>'
 SCANPLAN_OPERATOR_TOKEN=$token "$build/server/scanplan-server" --session "$work/session" \
-  --listen 127.0.0.1:0 --domain 62 --web "$src/web/dist" >"$work/server.log" 2>&1 &
+  --listen 127.0.0.1:0 --domain 202 --web "$src/web/dist" >"$work/server.log" 2>&1 &
 server_pid=$!
 for _ in $(seq 100); do
   url=$(grep -o 'listening on http://[0-9.:]*' "$work/server.log" | sed 's/listening on //' || true)

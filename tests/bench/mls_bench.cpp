@@ -12,10 +12,10 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
-#include "scanplan/core/mls_map.hpp"
-#include "scanplan/core/movable_region.hpp"
-#include "scanplan/core/region_segmentation.hpp"
-#include "scanplan/core/simulated_scanner.hpp"
+#include "scanplan/mapping/mls_map.hpp"
+#include "scanplan/mapping/movable_region.hpp"
+#include "scanplan/mapping/region_segmentation.hpp"
+#include "scanplan/sim/simulated_scanner.hpp"
 
 namespace {
 
@@ -39,7 +39,8 @@ double best_ms(int repeats, const std::function<void()>& setup, const std::funct
 class ElevationGrid {
  public:
   ElevationGrid(Eigen::Vector2d min, Eigen::Vector2d max, double cell)
-      : min_(min), inv_(1.0 / cell),
+      : min_(min),
+        inv_(1.0 / cell),
         cols_(static_cast<int>(std::ceil((max.x() - min.x()) * inv_))),
         rows_(static_cast<int>(std::ceil((max.y() - min.y()) * inv_))),
         height_(static_cast<std::size_t>(cols_) * rows_, std::nanf("")),
@@ -121,12 +122,13 @@ int main(int argc, char** argv) {
     map = MlsMap();
     for (const auto& [s, p] : history) map.insert_scan(s, p.isometry(), sensor);
   };
-  const double ms_mls = best_ms(5, build_history, [&] { map.insert_scan(scan, at.isometry(), sensor); });
+  const double ms_mls =
+      best_ms(5, build_history, [&] { map.insert_scan(scan, at.isometry(), sensor); });
   MlsConfig no_fill_config;
   no_fill_config.fill_between_beams = false;
   MlsMap no_fill(no_fill_config);
-  const double ms_mls_no_fill = best_ms(5, [&] { no_fill = MlsMap(no_fill_config); },
-                                        [&] { no_fill.insert(scan_map); });
+  const double ms_mls_no_fill = best_ms(
+      5, [&] { no_fill = MlsMap(no_fill_config); }, [&] { no_fill.insert(scan_map); });
 
   std::optional<ElevationGrid> grid;
   const Eigen::Vector3f sensor_map = (at.isometry() * sensor).cast<float>();
@@ -134,7 +136,8 @@ int main(int argc, char** argv) {
       5,
       [&] {
         grid.emplace(world.bounds_min, world.bounds_max, 1.0);
-        for (const auto& [s, p] : history) grid->add(placed(s, p), (p.isometry() * sensor).cast<float>());
+        for (const auto& [s, p] : history)
+          grid->add(placed(s, p), (p.isometry() * sensor).cast<float>());
       },
       [&] { grid->add(scan_map, sensor_map); });
 
@@ -142,30 +145,34 @@ int main(int argc, char** argv) {
   map.insert_scan(scan, at.isometry(), sensor);
   std::vector<Eigen::Vector2d> scan_points = earlier;
   scan_points.push_back({at.x, at.y});
-  const TargetRegion target = TargetRegion::of_world(world);
+  const TargetRegion target = world.target_region();
   RegionMap regions;
   MovableRegion movable;
-  const double ms_segment = best_ms(5, [] {}, [&] { regions = segment_regions(map, target, scan_points); });
-  const double ms_movable = best_ms(5, [] {}, [&] { movable = movable_region(map, {at.x, at.y, at.z}); });
+  const double ms_segment = best_ms(
+      5, [] {}, [&] { regions = segment_regions(map, target, scan_points); });
+  const double ms_movable = best_ms(
+      5, [] {},
+      [&] {
+        movable = movable_region(map, {at.x, at.y, at.z});
+      });
 
   const double n = static_cast<double>(scan.size());
-  const nlohmann::json out = {
-      {"bench", "mls_campus"},
-      {"scan_points", scan.size()},
-      {"map_scans_before", history.size()},
-      {"ms_mls_insert_scan", ms_mls},
-      {"mpts_per_s_mls", n / ms_mls / 1000.0},
-      {"ms_mls_insert_no_fill", ms_mls_no_fill},
-      {"ms_elevation_mapping_update", ms_elevation},
-      {"mpts_per_s_elevation_mapping", n / ms_elevation / 1000.0},
-      {"reported_elevation_mapping_mpts_per_s", 1.5},
-      {"ms_segment_regions", ms_segment},
-      {"ms_movable_region", ms_movable},
-      {"occupied_cells", map.occupied_cells()},
-      {"completed_m2", regions.completed_m2()},
-      {"low_resolution_m2", regions.low_resolution_m2()},
-      {"unscanned_m2", regions.unscanned_m2()},
-      {"movable_m2", movable.area_m2()}};
+  const nlohmann::json out = {{"bench", "mls_campus"},
+                              {"scan_points", scan.size()},
+                              {"map_scans_before", history.size()},
+                              {"ms_mls_insert_scan", ms_mls},
+                              {"mpts_per_s_mls", n / ms_mls / 1000.0},
+                              {"ms_mls_insert_no_fill", ms_mls_no_fill},
+                              {"ms_elevation_mapping_update", ms_elevation},
+                              {"mpts_per_s_elevation_mapping", n / ms_elevation / 1000.0},
+                              {"reported_elevation_mapping_mpts_per_s", 1.5},
+                              {"ms_segment_regions", ms_segment},
+                              {"ms_movable_region", ms_movable},
+                              {"occupied_cells", map.occupied_cells()},
+                              {"completed_m2", regions.completed_m2()},
+                              {"low_resolution_m2", regions.low_resolution_m2()},
+                              {"unscanned_m2", regions.unscanned_m2()},
+                              {"movable_m2", movable.area_m2()}};
   std::printf("%s\n", out.dump().c_str());
   return 0;
 }

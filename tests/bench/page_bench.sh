@@ -5,5 +5,5 @@
 set -euo pipefail
 src=$(cd "$(dirname "$0")/../.." && pwd)
 . "$src/tests/bench/node_bench_env.sh"
-export SCANPLAN_TEST_DOMAIN=${SCANPLAN_TEST_DOMAIN:-62}
+export SCANPLAN_TEST_DOMAIN=${SCANPLAN_TEST_DOMAIN:-201}
 exec node "$src/tests/bench/page_bench.mjs" "${1:-10}" "${2:-8}"

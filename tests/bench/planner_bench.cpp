@@ -26,14 +26,14 @@
 #include <string>
 #include <vector>
 
-#include "scanplan/core/closed_loop.hpp"
-#include "scanplan/core/coverage_chart.hpp"
-#include "scanplan/core/mls_map.hpp"
-#include "scanplan/core/scan_planner.hpp"
-#include "scanplan/core/simulated_scanner.hpp"
-#include "scanplan/core/top_view.hpp"
-#include "scanplan/core/visibility.hpp"
-#include "scanplan/core/world_traversability.hpp"
+#include "scanplan/experiments/closed_loop.hpp"
+#include "scanplan/experiments/coverage_chart.hpp"
+#include "scanplan/mapping/mls_map.hpp"
+#include "scanplan/mapping/top_view.hpp"
+#include "scanplan/planning/scan_planner.hpp"
+#include "scanplan/planning/visibility.hpp"
+#include "scanplan/sim/simulated_scanner.hpp"
+#include "scanplan/sim/world_traversability.hpp"
 
 namespace {
 
@@ -336,7 +336,7 @@ int main(int argc, char** argv) {
   const World world = load_world(world_file);
   const RayCaster caster(world);
   const WorldTraversability truth(world, caster);
-  const TargetRegion target = TargetRegion::of_world(world);
+  const TargetRegion target = world.target_region();
   const Eigen::Vector3d sensor(0, 0, world.scanner.mount_height_m);
 
   // The true pose of a robot put down at (x, y) near height z: on the real surface, tilted

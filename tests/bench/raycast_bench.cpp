@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
-#include "scanplan/core/simulated_scanner.hpp"
+#include "scanplan/sim/simulated_scanner.hpp"
 
 namespace {
 

@@ -19,11 +19,12 @@
 #include <string>
 #include <vector>
 
-#include "scanplan/core/alignment_quality.hpp"
-#include "scanplan/core/registration.hpp"
-#include "scanplan/core/simulated_scanner.hpp"
-#include "scanplan/core/voxel_filter.hpp"
-#include "scanplan/core/world_traversability.hpp"
+#include "scanplan/geometry/voxel_filter.hpp"
+#include "scanplan/registration/alignment_quality.hpp"
+#include "scanplan/registration/registration.hpp"
+#include "scanplan/registration_pcl/pcl_registration.hpp"
+#include "scanplan/sim/simulated_scanner.hpp"
+#include "scanplan/sim/world_traversability.hpp"
 
 namespace {
 
@@ -207,11 +208,11 @@ RegistrationResult run_method(const std::string& name, const Pair& p,
   const RegistrationConfig& c = p.config;
   if (name == "pcl-ndt+pcl-icp") {
     const RegistrationResult ndt =
-        pcl_ndt ? *pcl_ndt : register_scans(p.target, p.source, p.initial, Method::kPclNdt, c);
-    RegistrationConfig refine = c;
-    refine.pcl.icp_max_correspondence_m = kPclRefineCorrespondenceM;
+        pcl_ndt ? *pcl_ndt : register_scans(p.target, p.source, p.initial, PclMethod::kNdt, c);
+    PclConfig refine;
+    refine.icp_max_correspondence_m = kPclRefineCorrespondenceM;
     RegistrationResult icp =
-        register_scans(p.target, p.source, ndt.transform, Method::kPclIcp, refine);
+        register_scans(p.target, p.source, ndt.transform, PclMethod::kIcp, c, refine);
     icp.time_ms += ndt.time_ms;
     icp.iterations += ndt.iterations;
     icp.method = name;
@@ -227,7 +228,7 @@ RegistrationResult run_method(const std::string& name, const Pair& p,
     paper.ndt.cell_sizes_m = RegistrationConfig{}.ndt.cell_sizes_m;
     return register_scans(p.target, p.source, p.initial, Method::kNdtIcp, paper);
   }
-  return register_scans(p.target, p.source, p.initial, *parse_method(name), c);
+  return register_any(p.target, p.source, p.initial, *parse_any_method(name), c);
 }
 
 // Runs every method on every pair, pair by pair, so that a change in the load of this shared
@@ -363,7 +364,7 @@ int main(int argc, char** argv) {
     }
   }
   for (const auto& m : a.methods) {
-    if (!parse_method(m) && m != "ndt-icp-6dof" && m != "ndt-icp-paper-cells" &&
+    if (!parse_any_method(m) && m != "ndt-icp-6dof" && m != "ndt-icp-paper-cells" &&
         m != "pcl-ndt+pcl-icp") {
       std::fprintf(stderr, "unknown method %s\n", m.c_str());
       return 2;

@@ -5,5 +5,5 @@
 set -euo pipefail
 src=$(cd "$(dirname "$0")/../.." && pwd)
 . "$src/tests/bench/node_bench_env.sh"
-export SCANPLAN_TEST_DOMAIN=${SCANPLAN_TEST_DOMAIN:-61}
+export SCANPLAN_TEST_DOMAIN=${SCANPLAN_TEST_DOMAIN:-200}
 exec node "$src/tests/bench/server_bench.mjs" "${1:-30}"

@@ -12,18 +12,18 @@
 #include "child_process.hpp"
 #include "ros2_types.h"
 #include "scanplan.h"
-#include "scanplan/core/colorizer.hpp"
-#include "scanplan/core/image_codec.hpp"
+#include "scanplan/io/image_codec.hpp"
+#include "scanplan/mapping/colorizer.hpp"
 #include "scanplan/msgs/camera_info.hpp"
 #include "scanplan/msgs/dds_participant.hpp"
 #include "scanplan/msgs/pointcloud2.hpp"
 #include "scanplan/msgs/pose_stamped.hpp"
 #include "scanplan/msgs/topics.hpp"
+#include "test_domain.hpp"
 
 namespace scanplan {
 namespace {
 
-constexpr std::uint32_t kDomain = 46;
 using namespace std::chrono_literals;
 
 // Polls `fn` until it returns true or the timeout passes.
@@ -56,10 +56,10 @@ class BridgeCommands : public ::testing::Test {
 
     // The status topic keeps the last sample only: a drive must last long enough (18 m at 50×:
     // 0.7 s) for the test to see "moving" before "arrived" replaces it, on a loaded machine too.
-    bridge_ =
-        new test::ChildProcess(SCANPLAN_BRIDGE, {"--world", world_file_->string(), "--domain",
-                                                 std::to_string(kDomain), "--time-scale", "50"});
-    participant_ = new dds::Participant(kDomain);
+    bridge_ = new test::ChildProcess(SCANPLAN_BRIDGE,
+                                     {"--world", world_file_->string(), "--domain",
+                                      std::to_string(test::test_domain()), "--time-scale", "50"});
+    participant_ = new dds::Participant(test::test_domain());
     using dds::QosKind;
     auto& p = *participant_;
     move_ = p.writer(scanplan_MoveCommand_desc, topics::kMoveCommand, QosKind::kCommand);

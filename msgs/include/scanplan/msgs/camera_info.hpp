@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "ros2_types.h"
-#include "scanplan/core/panorama_camera.hpp"
+#include "scanplan/geometry/panorama_camera.hpp"
 
 namespace scanplan::dds {
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "ros2_types.h"
-#include "scanplan/core/point_cloud.hpp"
+#include "scanplan/geometry/point_cloud.hpp"
 
 namespace scanplan::dds {
 

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "ros2_types.h"
-#include "scanplan/core/pose.hpp"
+#include "scanplan/geometry/pose.hpp"
 
 namespace scanplan::dds {
 

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "ros2_types.h"
-#include "scanplan/core/pose.hpp"
+#include "scanplan/geometry/pose.hpp"
 
 namespace scanplan::dds {
 

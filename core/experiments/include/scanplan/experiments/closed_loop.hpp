@@ -1,0 +1,57 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "scanplan/mission/mission_pipeline.hpp"
+#include "scanplan/sim/world.hpp"
+
+namespace scanplan {
+
+struct ClosedLoopConfig {
+  PlannerConfig planner;
+  PipelineConfig pipeline;
+  int max_scans = 13;  // the paper's campus run took 13 scans (§3.5)
+  std::uint64_t seed = 1;
+  // Stop once this share of the reachable ground is scan-completed (100: never early).
+  double stop_at_coverage_pct = 100.0;
+  // Scan matching of each new scan against the map so far (paper §4); nothing: scans are placed
+  // at the reported pose.
+  std::optional<MapMatchConfig> matching = MapMatchConfig{};
+};
+
+// One scan of the loop and the decision taken after it.
+struct LoopStep {
+  int scan = 0;        // 1-based
+  Pose true_pose;      // where the robot really scanned
+  Pose reported_pose;  // what the robot's pose sensors said
+  Pose placed_pose;    // where the map put the scan (matched when matching is on)
+  std::optional<RegistrationResult> match;
+  double detected_m2 = 0;             // C ∪ M, the paper's detection area
+  double completed_m2 = 0;            // C
+  double coverage_pct = 0;            // reachable ground cells of the target region that are in C
+  double path_m = 0;                  // driven so far, over the true ground
+  double plan_ms = 0;                 // planning after this scan (0 after the last)
+  std::vector<Candidate> candidates;  // ranked, as the operator would see them
+  std::optional<std::size_t> chosen;  // the candidate driven to, if any
+};
+
+struct LoopResult {
+  std::vector<LoopStep> steps;
+  std::size_t reachable_cells = 0;  // the coverage denominator
+  std::optional<int> scans_to_95pct;
+  std::optional<double> path_to_95pct_m;
+  std::string stopped_because;
+};
+
+// The paper's procedure (§3: scan, map, movable region, plan, move, repeat) on a simulated
+// world: scans at the true pose, placed in the map at the reported one; the robot drives to
+// the best-ranked candidate it can really reach (an operator approving the top suggestion).
+// `on_step` sees each step with the map as it stands after that scan.
+LoopResult run_closed_loop(
+    const World& world, const ClosedLoopConfig& config,
+    const std::function<void(const LoopStep&, const MappingPipeline&)>& on_step = {});
+
+}  // namespace scanplan

@@ -1,0 +1,117 @@
+#include "scanplan/experiments/closed_loop.hpp"
+
+#include <chrono>
+#include <random>
+#include <set>
+
+#include "scanplan/sim/simulated_scanner.hpp"
+#include "scanplan/sim/world_traversability.hpp"
+
+namespace scanplan {
+namespace {
+
+// The coverage denominator: MLS cells of the target region holding ground the robot could
+// reach from its start in the true world (DESIGN.md: coverage_pct).
+std::vector<CellIndex> reachable_ground_cells(const World& world, const WorldTraversability& trav,
+                                              const WorldTraversability::Reach& reach,
+                                              const MlsMap& map) {
+  std::set<std::pair<std::int32_t, std::int32_t>> cells;
+  for (std::size_t c = 0; c < trav.cell_count(); ++c) {
+    if (!reach.reachable(c)) continue;
+    const Eigen::Vector2d p = trav.cell_center(c);
+    const CellIndex i = map.index_of(p.x(), p.y());
+    const Eigen::Vector2d center = map.center_of(i);
+    if (world.in_target_region(center.x(), center.y())) cells.insert({i.x, i.y});
+  }
+  std::vector<CellIndex> out;
+  out.reserve(cells.size());
+  for (const auto& [x, y] : cells) out.push_back({x, y});
+  return out;
+}
+
+}  // namespace
+
+LoopResult run_closed_loop(
+    const World& world, const ClosedLoopConfig& config,
+    const std::function<void(const LoopStep&, const MappingPipeline&)>& on_step) {
+  const RayCaster caster(world);
+  const WorldTraversability trav(world, caster);
+  Pose truth = trav.standing_pose(world.start.x, world.start.y, world.start.z, world.start.yaw);
+  const auto reach_from_start = trav.reach_from(truth.x, truth.y, truth.z);
+
+  MissionConfig mission_config{config.pipeline, config.planner, config.matching};
+  mission_config.mapping.sensor_height_m = world.scanner.mount_height_m;
+  MissionPipeline mission(mission_config);
+  mission.set_target(world.target_region());
+  const MappingPipeline& pipeline = mission.mapping();
+  const auto ground = reachable_ground_cells(world, trav, reach_from_start, pipeline.map());
+
+  LoopResult result;
+  result.reachable_cells = ground.size();
+  std::mt19937_64 pose_rng(config.seed);
+  double path_m = 0;
+  for (int scan = 1; scan <= config.max_scans; ++scan) {
+    LoopStep step;
+    step.scan = scan;
+    step.true_pose = truth;
+    const PointCloud cloud = simulate_scan(caster, world.scanner, truth,
+                                           config.seed * 7919 + static_cast<std::uint64_t>(scan));
+    step.reported_pose = reported_pose(truth, world.pose_noise, pose_rng);
+    step.placed_pose = step.reported_pose;
+    if (const auto m = mission.place(cloud, step.reported_pose)) {
+      step.match = m->result;
+      step.placed_pose = m->placed;
+    }
+    mission.add(cloud, step.placed_pose);
+
+    const RegionMap& regions = *pipeline.regions();
+    step.detected_m2 = regions.detected_m2();
+    step.completed_m2 = regions.completed_m2();
+    std::size_t covered = 0;
+    for (const CellIndex& c : ground) covered += regions.at(c) == Region::kCompleted;
+    step.coverage_pct = ground.empty() ? 0.0 : 100.0 * covered / ground.size();
+    step.path_m = path_m;
+    if (!result.scans_to_95pct && step.coverage_pct >= 95.0) {
+      result.scans_to_95pct = scan;
+      result.path_to_95pct_m = path_m;
+    }
+
+    const bool last = scan == config.max_scans || step.coverage_pct >= config.stop_at_coverage_pct;
+    if (!last) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const Plan plan =
+          mission.plan_from({step.placed_pose.x, step.placed_pose.y, step.placed_pose.z},
+                            config.planner.seed * 1000003u + static_cast<std::uint64_t>(scan));
+      step.plan_ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      step.candidates = plan.ranked;
+      // The map was built from noisy poses: a suggestion may not be drivable in reality.
+      const auto reach = trav.reach_from(truth.x, truth.y, truth.z);
+      for (std::size_t k = 0; k < plan.ranked.size() && !step.chosen; ++k) {
+        const Eigen::Vector3d& goal = plan.ranked[k].position;
+        const auto cell = trav.cell_of(goal.x(), goal.y());
+        if (cell && reach.reachable(*cell)) {
+          step.chosen = k;
+          path_m += reach.distance_m[*cell];
+          truth = trav.standing_pose(goal.x(), goal.y(), reach.z[*cell], truth.yaw);
+        }
+      }
+    }
+    if (on_step) on_step(step, pipeline);
+    result.steps.push_back(std::move(step));
+    const LoopStep& done = result.steps.back();
+    if (done.coverage_pct >= config.stop_at_coverage_pct) {
+      result.stopped_because = "coverage reached";
+      break;
+    }
+    if (!last && !done.chosen) {
+      result.stopped_because = done.candidates.empty() ? "the planner found nothing left to scan"
+                                                       : "no suggested point is reachable";
+      break;
+    }
+    if (last) result.stopped_because = "scan limit reached";
+  }
+  return result;
+}
+
+}  // namespace scanplan

@@ -1,0 +1,58 @@
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "scanplan/geometry/pose.hpp"
+#include "scanplan/geometry/target_region.hpp"
+#include "scanplan/mapping/mls_map.hpp"
+#include "scanplan/mapping/movable_region.hpp"
+#include "scanplan/mapping/region_segmentation.hpp"
+
+namespace scanplan {
+
+struct PipelineConfig {
+  MlsConfig mls;
+  MovableConfig movable;
+  RegionConfig regions;
+  double sensor_height_m = 1.0;  // the laser's centre above the scan frame's origin
+  // Until the operator draws a target region, the one used is a square of this side centred
+  // on the first scan point (the paper's campus is about 200 m across, §3.5).
+  double default_target_side_m = 200.0;
+};
+
+// The mapping half of the paper's loop (§3, steps 1–3): each scan goes into the MLS map at its
+// (corrected) pose, then the movable region and the C/M/U segmentation are brought up to date.
+// Pure computation: the server serialises access to it.
+class MappingPipeline {
+ public:
+  explicit MappingPipeline(PipelineConfig config = {});
+
+  // `cloud` in the scan's own frame (origin on the ground under the scanner), in measuring
+  // order; `pose` places it in the map.
+  InsertStats add_scan(const PointCloud& cloud, const Pose& pose);
+  void set_target(TargetRegion target);
+  // New thresholds for segmentation (completed radius) and the movable region (step height).
+  void set_region_configs(const RegionConfig& regions, const MovableConfig& movable);
+
+  const MlsMap& map() const { return map_; }
+  const std::vector<Pose>& scan_poses() const { return poses_; }
+  std::vector<Eigen::Vector2d> scan_points() const;
+  // Nothing before the first scan (and no target region set).
+  const std::optional<TargetRegion>& target() const { return target_; }
+  const std::optional<RegionMap>& regions() const { return regions_; }
+  const std::optional<MovableRegion>& movable() const { return movable_; }
+  const PipelineConfig& config() const { return config_; }
+
+ private:
+  void update_regions();
+
+  PipelineConfig config_;
+  MlsMap map_;
+  std::vector<Pose> poses_;
+  std::optional<TargetRegion> target_;
+  std::optional<RegionMap> regions_;
+  std::optional<MovableRegion> movable_;
+};
+
+}  // namespace scanplan

@@ -1,0 +1,138 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "scanplan/geometry/cell_index.hpp"
+#include "scanplan/geometry/point_cloud.hpp"
+
+namespace scanplan {
+
+struct MlsConfig {
+  double cell_m = 1.0;  // paper §3.5: 1.0 m cells
+  // Points closer in height than this join one patch; a larger gap is free space the robot fits
+  // into, so the ground under a canopy stays a surface of its own (paper §3.1, Fig. 2-3).
+  double robot_height_m = 1.5;
+  // Points farther than this from the map origin are refused: a coordinate like 1e30 is a
+  // broken scan, and storing it would only grow the map without end.
+  double max_coordinate_m = 1e6;
+  // Beyond about 10 m the ground returns of neighbouring beams of one fan land metres apart
+  // (spacing ≈ range² · step / height), leaving rings of data with unseen cells between them.
+  // The beam passed over those cells without meeting anything, so insert_scan fills them with
+  // the surface interpolated between the two returns, where that surface is gentle enough
+  // (slope below fill_max_slope) and the returns no farther apart than fill_max_gap_m.
+  bool fill_between_beams = true;
+  double fill_max_gap_m = 10.0;
+  double fill_max_slope = 0.25;
+};
+
+// One surface in a cell: the heights of the points that fell on it.
+struct SurfacePatch {
+  float min_z = 0, max_z = 0;
+  float mean_z = 0;
+  float m2 = 0;  // sum of squared deviations from the mean (Welford)
+  std::uint32_t count = 0;
+
+  float variance() const { return count > 1 ? m2 / static_cast<float>(count - 1) : 0.0f; }
+  float extent() const { return max_z - min_z; }  // vertical depth: walls are deep, floors thin
+  void add(float z);
+  void merge(const SurfacePatch& other);
+};
+
+// The surfaces of one cell, lowest first. Four fit without any allocation; a fifth surface in
+// one cell (four gaps taller than the robot stacked in 1 m²) is folded into its nearest one.
+struct MlsCell {
+  static constexpr int kMaxPatches = 4;
+  std::array<SurfacePatch, kMaxPatches> patches{};
+  std::uint8_t size = 0;
+  // Every height here was interpolated between two beams (MlsConfig::fill_between_beams), none
+  // measured. The first measured point replaces them: interpolation across the foot of a wall
+  // leaves a slope that is not there, and folded into the real ground it would make the cell
+  // one deep patch instead of a floor.
+  bool interpolated = false;
+
+  bool empty() const { return size == 0; }
+  const SurfacePatch* begin() const { return patches.data(); }
+  const SurfacePatch* end() const { return patches.data() + size; }
+  // The highest point in the cell: what a DEM keeps (paper §3.1, Fig. 2-b).
+  float dem_height() const { return patches[size - 1].max_z; }
+};
+
+struct InsertStats {
+  std::size_t inserted = 0;
+  std::size_t rejected = 0;  // non-finite or absurdly far points
+};
+
+// A Multi-Level Surface map (Triebel, Pfaff, Burgard 2006) over an x-y grid that grows as scans
+// arrive. Cells live in square tiles created on first touch, so the map has no fixed size and
+// consecutive points of a scan (which are neighbours) mostly stay within one tile.
+class MlsMap {
+ public:
+  explicit MlsMap(MlsConfig config = {});
+
+  // Points already in the map frame (after matching). Non-finite points are refused.
+  InsertStats insert(const PointCloud& cloud);
+  InsertStats insert(const std::vector<Eigen::Vector3f>& points);
+  // A whole scan in its sensor's own frame, in the order the scanner measured it (fan by fan),
+  // placed by `map_from_scan`; fills the ground between neighbouring returns of a fan (see
+  // MlsConfig::fill_between_beams). `sensor_in_scan` is the laser's centre in the scan frame.
+  InsertStats insert_scan(const PointCloud& scan, const Eigen::Isometry3d& map_from_scan,
+                          const Eigen::Vector3d& sensor_in_scan);
+
+  const MlsConfig& config() const { return config_; }
+  double cell_m() const { return config_.cell_m; }
+  CellIndex index_of(double x, double y) const;
+  Eigen::Vector2d center_of(CellIndex c) const;
+  // Null when nothing was ever seen there.
+  const MlsCell* cell(CellIndex c) const;
+  // Inclusive bounds of all touched cells; nothing while the map is empty.
+  std::optional<std::pair<CellIndex, CellIndex>> extent() const;
+  std::size_t occupied_cells() const { return occupied_; }
+
+  // Calls fn(CellIndex, const MlsCell&) for every occupied cell (in no particular order).
+  template <typename Fn>
+  void for_each_cell(Fn&& fn) const;
+
+  static constexpr int kTileBits = 5;  // 32 × 32 cells a tile
+  static constexpr int kTileSize = 1 << kTileBits;
+
+ private:
+  struct Tile {
+    std::array<MlsCell, kTileSize * kTileSize> cells{};
+  };
+  static std::uint64_t tile_key(std::int32_t tx, std::int32_t ty);
+  void insert_point(const Eigen::Vector3f& p, Tile*& cached, std::uint64_t& cached_key);
+  void add_to_cell(MlsCell& cell, float z);
+  MlsCell& touch(CellIndex c, Tile*& cached, std::uint64_t& cached_key);
+  void fill_between(const Eigen::Vector3f& a, const Eigen::Vector3f& b, Tile*& cached,
+                    std::uint64_t& cached_key);
+
+  MlsConfig config_;
+  float gap_;
+  double inv_cell_;
+  std::unordered_map<std::uint64_t, std::unique_ptr<Tile>> tiles_;
+  std::size_t occupied_ = 0;
+  CellIndex min_{}, max_{};
+};
+
+template <typename Fn>
+void MlsMap::for_each_cell(Fn&& fn) const {
+  for (const auto& [key, tile] : tiles_) {
+    const std::int32_t tx = static_cast<std::int32_t>(key >> 32);
+    const std::int32_t ty = static_cast<std::int32_t>(key & 0xffffffffu);
+    for (int j = 0; j < kTileSize; ++j) {
+      for (int i = 0; i < kTileSize; ++i) {
+        const MlsCell& c = tile->cells[j * kTileSize + i];
+        if (!c.empty()) fn(CellIndex{tx * kTileSize + i, ty * kTileSize + j}, c);
+      }
+    }
+  }
+}
+
+}  // namespace scanplan

@@ -1,0 +1,47 @@
+#include "scanplan/mapping/mapping_pipeline.hpp"
+
+namespace scanplan {
+
+MappingPipeline::MappingPipeline(PipelineConfig config) : config_(config), map_(config.mls) {}
+
+InsertStats MappingPipeline::add_scan(const PointCloud& cloud, const Pose& pose) {
+  const InsertStats stats =
+      map_.insert_scan(cloud, pose.isometry(), Eigen::Vector3d(0, 0, config_.sensor_height_m));
+  poses_.push_back(pose);
+  if (!target_) {
+    const Eigen::Vector2d half = Eigen::Vector2d::Constant(config_.default_target_side_m / 2);
+    const Eigen::Vector2d c(pose.x, pose.y);
+    target_ = TargetRegion::rectangle(c - half, c + half);
+  }
+  update_regions();
+  return stats;
+}
+
+void MappingPipeline::set_target(TargetRegion target) {
+  target_ = std::move(target);
+  update_regions();
+}
+
+void MappingPipeline::set_region_configs(const RegionConfig& regions,
+                                         const MovableConfig& movable) {
+  config_.regions = regions;
+  config_.movable = movable;
+  update_regions();
+}
+
+std::vector<Eigen::Vector2d> MappingPipeline::scan_points() const {
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(poses_.size());
+  for (const Pose& p : poses_) out.emplace_back(p.x, p.y);
+  return out;
+}
+
+void MappingPipeline::update_regions() {
+  if (poses_.empty() || !target_) return;
+  regions_ = segment_regions(map_, *target_, scan_points(), config_.regions);
+  // The robot stands where it scanned last; its floor is the pose's height.
+  const Pose& robot = poses_.back();
+  movable_ = movable_region(map_, {robot.x, robot.y, robot.z}, config_.movable);
+}
+
+}  // namespace scanplan

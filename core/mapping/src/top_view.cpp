@@ -1,0 +1,116 @@
+#include "scanplan/mapping/top_view.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+namespace scanplan {
+namespace {
+
+const cv::Vec3b kOutside(24, 20, 20);  // BGR
+const cv::Vec3b kUnscanned(64, 64, 64);
+const cv::Vec3b kCompleted(180, 214, 250);     // flesh
+const cv::Vec3b kLowMovable(64, 208, 236);     // yellow
+const cv::Vec3b kLowNotMovable(200, 110, 70);  // blue
+const cv::Vec3b kMovable(90, 190, 90);
+const cv::Vec3b kData(150, 150, 150);
+
+// Fills each cell of the regions' grid with fn(cell, region), north up.
+template <typename Fn>
+cv::Mat paint(const RegionMap& regions, const TopViewStyle& style, Fn&& fn) {
+  const auto& g = regions.cells;
+  const int s = std::max(1, style.px_per_cell);
+  cv::Mat img(g.rows * s, g.cols * s, CV_8UC3);
+  for (int j = 0; j < g.rows; ++j) {
+    for (int i = 0; i < g.cols; ++i) {
+      const CellIndex c{g.origin.x + i, g.origin.y + j};
+      const cv::Vec3b color = fn(c, g.values[static_cast<std::size_t>(j) * g.cols + i]);
+      img(cv::Rect(i * s, (g.rows - 1 - j) * s, s, s))
+          .setTo(cv::Scalar(color[0], color[1], color[2]));
+    }
+  }
+  return img;
+}
+
+}  // namespace
+
+cv::Mat render_regions(const RegionMap& regions, const MovableRegion* movable,
+                       const std::vector<Eigen::Vector2d>& scan_points, const TopViewStyle& style) {
+  cv::Mat img = paint(regions, style, [&](CellIndex c, Region r) {
+    switch (r) {
+      case Region::kOutside:
+        return kOutside;
+      case Region::kUnscanned:
+        return kUnscanned;
+      case Region::kCompleted:
+        return kCompleted;
+      case Region::kLowResolution:
+        return movable && movable->contains(c) ? kLowMovable : kLowNotMovable;
+    }
+    return kOutside;
+  });
+  const int s = std::max(1, style.px_per_cell);
+  const int radius = std::max(3, 2 * s);
+  for (std::size_t k = 0; k < scan_points.size(); ++k) {
+    const bool first = k == 0, last = k + 1 == scan_points.size() && k > 0;
+    const cv::Scalar color = first  ? cv::Scalar(220, 60, 20)
+                             : last ? cv::Scalar(30, 30, 220)
+                                    : cv::Scalar(40, 40, 40);
+    const cv::Point p = top_view_pixel(regions, scan_points[k], style);
+    cv::circle(img, p, radius, color, -1, cv::LINE_AA);
+    cv::circle(img, p, radius, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  }
+  return img;
+}
+
+cv::Mat render_elevation(const MlsMap& map, const RegionMap& regions, const TopViewStyle& style) {
+  float lo = std::numeric_limits<float>::max(), hi = std::numeric_limits<float>::lowest();
+  const auto& g = regions.cells;
+  for (std::size_t o = 0; o < g.values.size(); ++o) {
+    if (g.values[o] == Region::kOutside) continue;
+    if (const MlsCell* cell = map.cell(g.index_at(o))) {
+      lo = std::min(lo, cell->dem_height());
+      hi = std::max(hi, cell->dem_height());
+    }
+  }
+  const float span = hi > lo ? hi - lo : 1.0f;
+  cv::Mat level = paint(regions, style, [&](CellIndex c, Region r) {
+    const MlsCell* cell = r == Region::kOutside ? nullptr : map.cell(c);
+    // Level 0 is kept for "no data"; heights use 1..255.
+    const int v = cell ? 1 + static_cast<int>(254.0f * (cell->dem_height() - lo) / span) : 0;
+    return cv::Vec3b(v, v, v);
+  });
+  cv::Mat gray, colored;
+  cv::extractChannel(level, gray, 0);
+  cv::applyColorMap(gray, colored, cv::COLORMAP_TURBO);
+  colored.setTo(cv::Scalar(kOutside[0], kOutside[1], kOutside[2]), gray == 0);
+  return colored;
+}
+
+cv::Mat render_movable(const MlsMap& map, const MovableRegion& movable, const RegionMap& regions,
+                       const TopViewStyle& style) {
+  return paint(regions, style, [&](CellIndex c, Region r) {
+    if (r == Region::kOutside) return kOutside;
+    if (movable.contains(c)) return kMovable;
+    return map.cell(c) ? kData : kUnscanned;
+  });
+}
+
+cv::Point top_view_pixel(const RegionMap& regions, const Eigen::Vector2d& p,
+                         const TopViewStyle& style) {
+  const auto& g = regions.cells;
+  const int s = std::max(1, style.px_per_cell);
+  const double x = (p.x() / g.cell_m - g.origin.x) * s;
+  const double y = (g.rows - (p.y() / g.cell_m - g.origin.y)) * s;
+  return {static_cast<int>(std::lround(x)), static_cast<int>(std::lround(y))};
+}
+
+std::vector<std::uint8_t> encode_png(const cv::Mat& bgr) {
+  std::vector<std::uint8_t> out;
+  if (!cv::imencode(".png", bgr, out)) throw std::runtime_error("PNG encoding failed");
+  return out;
+}
+
+}  // namespace scanplan

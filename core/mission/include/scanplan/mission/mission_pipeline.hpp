@@ -1,0 +1,71 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "scanplan/geometry/point_cloud.hpp"
+#include "scanplan/geometry/pose.hpp"
+#include "scanplan/mapping/mapping_pipeline.hpp"
+#include "scanplan/planning/fleet_planner.hpp"
+#include "scanplan/planning/scan_planner.hpp"
+#include "scanplan/registration/map_matcher.hpp"
+
+namespace scanplan {
+
+struct MissionConfig {
+  PipelineConfig mapping;
+  PlannerConfig planner;
+  // Scan matching of each new scan against the map so far (paper §4); nothing: scans go where
+  // the robot says they are.
+  std::optional<MapMatchConfig> matching = MapMatchConfig{};
+};
+
+// The paper's loop as one object (§3 steps 1–4 with §4's matching), used alike by the server
+// and by the closed-loop simulation: a scan comes in with the pose the robot reports, is
+// matched against the map so far (placed), joins the MLS map (mapped), the movable region and
+// the C/M/U segmentation follow (segmented), and the next scan points are chosen (planned).
+// Pure computation and not thread-safe: its owner serialises access.
+class MissionPipeline {
+ public:
+  explicit MissionPipeline(MissionConfig config = {});
+
+  // Placed: where scan `scan` (its own frame) goes, matched against the map's points near
+  // `reported` (MapMatchConfig::target_radius_m). Nothing when matching is off or the map is
+  // still empty (the first scan defines the map frame). Changes nothing.
+  std::optional<MapMatch> place(const PointCloud& scan, const Pose& reported) const;
+
+  // Mapped and segmented: the scan joins the map at `placed`. Returns its points in the map
+  // frame (coloured; grey where the scan had no colour), shared, never copied again.
+  std::shared_ptr<const PointCloud> add(const PointCloud& scan, const Pose& placed);
+
+  // Planned: the next scan point for each robot (plan_fleet, PlanInput::claimed for `claimed`,
+  // the goals of robots already driving). Empty before the first scan.
+  std::vector<FleetPlan> plan(const std::vector<FleetRobot>& robots,
+                              std::vector<Eigen::Vector3d> claimed = {}) const;
+  // One robot standing at `robot` (x, y, floor z); `seed` for the policies that draw at random.
+  Plan plan_from(const Eigen::Vector3d& robot, std::uint64_t seed) const;
+
+  // New planner parameters; the segmentation and the movable region follow their thresholds.
+  void set_planner(const PlannerConfig& planner);
+  void set_target(TargetRegion target);
+
+  // The map's points (map frame) within `radius_m` of (x, y) in the x-y plane.
+  PointCloud points_near(double x, double y, double radius_m) const;
+  // Each scan's points in the map frame, in the order they joined.
+  const std::vector<std::shared_ptr<const PointCloud>>& placed_scans() const { return placed_; }
+  const MappingPipeline& mapping() const { return mapping_; }
+  const PlannerConfig& planner() const { return config_.planner; }
+  const MissionConfig& config() const { return config_; }
+  // Whether there is a map to plan on (a first scan, its regions and movable region).
+  bool has_map() const;
+
+ private:
+  MissionConfig config_;
+  MappingPipeline mapping_;
+  std::vector<std::shared_ptr<const PointCloud>> placed_;
+};
+
+}  // namespace scanplan

@@ -1,0 +1,80 @@
+#include "scanplan/mission/mission_pipeline.hpp"
+
+#include <utility>
+
+namespace scanplan {
+namespace {
+
+// The pipeline's region thresholds are the planner's: one set, changed by the operator.
+PipelineConfig with_planner_thresholds(PipelineConfig mapping, const PlannerConfig& planner) {
+  mapping.regions = planner.regions;
+  mapping.movable = planner.movable;
+  return mapping;
+}
+
+}  // namespace
+
+MissionPipeline::MissionPipeline(MissionConfig config)
+    : config_(std::move(config)),
+      mapping_(with_planner_thresholds(config_.mapping, config_.planner)) {}
+
+bool MissionPipeline::has_map() const {
+  return mapping_.regions() && mapping_.movable() && mapping_.target();
+}
+
+std::optional<MapMatch> MissionPipeline::place(const PointCloud& scan, const Pose& reported) const {
+  if (!config_.matching || placed_.empty()) return std::nullopt;
+  return match_to_map(points_near(reported.x, reported.y, config_.matching->target_radius_m), scan,
+                      reported, *config_.matching);
+}
+
+std::shared_ptr<const PointCloud> MissionPipeline::add(const PointCloud& scan, const Pose& placed) {
+  const Eigen::Affine3f map_from_scan = placed.isometry().cast<float>();
+  PointCloud in_map;
+  in_map.reserve(scan.size());
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    in_map.push_back(map_from_scan * scan.points[i],
+                     scan.has_colors() ? scan.colors[i] : Rgb{128, 128, 128});
+  }
+  mapping_.add_scan(scan, placed);
+  placed_.push_back(std::make_shared<const PointCloud>(std::move(in_map)));
+  return placed_.back();
+}
+
+std::vector<FleetPlan> MissionPipeline::plan(const std::vector<FleetRobot>& robots,
+                                             std::vector<Eigen::Vector3d> claimed) const {
+  if (!has_map()) return {};
+  return plan_fleet(mapping_.map(), *mapping_.target(), mapping_.scan_points(), robots,
+                    std::move(claimed), config_.planner);
+}
+
+Plan MissionPipeline::plan_from(const Eigen::Vector3d& robot, std::uint64_t seed) const {
+  if (!has_map()) return {};
+  PlannerConfig planner = config_.planner;
+  planner.seed = seed;
+  const std::vector<Eigen::Vector2d> points = mapping_.scan_points();
+  return plan_next_scan({mapping_.map(), *mapping_.target(), points, robot}, planner);
+}
+
+void MissionPipeline::set_planner(const PlannerConfig& planner) {
+  config_.planner = planner;
+  mapping_.set_region_configs(planner.regions, planner.movable);
+}
+
+void MissionPipeline::set_target(TargetRegion target) {
+  mapping_.set_target(std::move(target));
+}
+
+PointCloud MissionPipeline::points_near(double x, double y, double radius_m) const {
+  PointCloud out;
+  const Eigen::Vector2f c(static_cast<float>(x), static_cast<float>(y));
+  const float r2 = static_cast<float>(radius_m * radius_m);
+  for (const auto& part : placed_) {
+    for (const auto& p : part->points) {
+      if ((p.head<2>() - c).squaredNorm() <= r2) out.points.push_back(p);
+    }
+  }
+  return out;
+}
+
+}  // namespace scanplan

@@ -1,0 +1,47 @@
+#pragma once
+
+#include "scanplan/mapping/mls_map.hpp"
+#include "scanplan/mapping/region_segmentation.hpp"
+#include "scanplan/planning/visibility.hpp"
+
+namespace scanplan {
+
+// The terms of the paper's evaluation function (§3.4, Eq. 1) for one candidate B:
+//   F = α · area((U ∩ C_B) ∪ (U ∩ M_B)) + (1 − α) · area(M_A ∩ C_B)
+// where C_B are the cells a scan from B is predicted to see within completed_radius_m of B
+// and M_B those it sees farther out; U and M_A are the current unscanned and low-resolution
+// regions. (U ∩ C_B) ∪ (U ∩ M_B) is simply U ∩ (seen from B).
+struct ScanGain {
+  double f = 0;
+  double unscanned_m2 = 0;       // area((U∩C_B) ∪ (U∩M_B))
+  double low_resolution_m2 = 0;  // area(M_A∩C_B)
+  // area((U∪M_A)∩C_B): what the scan would bring into C. Not a term of F; the exhaustive
+  // policy breaks near-ties in F with it (PlannerConfig::completion_weight).
+  double completed_m2 = 0;
+};
+
+// Evaluates Eq. 1 at cells of the map against one region segmentation. Cheap to call many
+// times: the visibility predictor is built once. Thread-safe with one workspace per thread.
+class ScanGainEvaluator {
+ public:
+  // `alpha` is the paper's weight α (§3.4), in [0, 1]; throws std::invalid_argument otherwise.
+  // `regions` must outlive the evaluator; the map is copied.
+  ScanGainEvaluator(const MlsMap& map, const RegionMap& regions, double alpha,
+                    const RegionConfig& region_config, const VisibilityConfig& visibility);
+
+  VisibilityPredictor::Workspace workspace() const { return predictor_.workspace(); }
+  // F at the centre of cell `b`, the robot standing on a floor at `floor_z`.
+  ScanGain at(CellIndex b, double floor_z, VisibilityPredictor::Workspace& ws) const;
+  ScanGain at(CellIndex b, double floor_z) const;
+
+  double alpha() const { return alpha_; }
+  const VisibilityPredictor& predictor() const { return predictor_; }
+
+ private:
+  const RegionMap& regions_;
+  double alpha_;
+  double completed_radius_cells2_;
+  VisibilityPredictor predictor_;
+};
+
+}  // namespace scanplan

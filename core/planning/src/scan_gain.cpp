@@ -1,0 +1,61 @@
+#include "scanplan/planning/scan_gain.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace scanplan {
+
+ScanGainEvaluator::ScanGainEvaluator(const MlsMap& map, const RegionMap& regions, double alpha,
+                                     const RegionConfig& region_config,
+                                     const VisibilityConfig& visibility)
+    : regions_(regions),
+      alpha_(alpha),
+      completed_radius_cells2_(std::pow(region_config.completed_radius_m / map.cell_m(), 2)),
+      predictor_(map, regions.cells, visibility) {
+  if (!(alpha >= 0 && alpha <= 1)) {
+    throw std::invalid_argument("alpha (paper Eq. 1 weight) must be in [0, 1], got " +
+                                std::to_string(alpha));
+  }
+  if (!(region_config.completed_radius_m > 0)) {
+    throw std::invalid_argument("completed_radius_m must be greater than zero");
+  }
+  if (regions.cells.cell_m != map.cell_m()) {
+    throw std::invalid_argument("the region map and the MLS map must share one cell size");
+  }
+}
+
+ScanGain ScanGainEvaluator::at(CellIndex b, double floor_z,
+                               VisibilityPredictor::Workspace& ws) const {
+  const auto& grid = regions_.cells;
+  const std::int64_t bi = b.x - grid.origin.x, bj = b.y - grid.origin.y;
+  std::size_t unscanned = 0, low_resolution = 0, unscanned_near = 0;
+  for (const std::uint32_t o : predictor_.visible_from(b, floor_z, ws)) {
+    const Region r = grid.values[o];
+    if (r != Region::kUnscanned && r != Region::kLowResolution) continue;
+    // C_B: within the completed radius of B, measured between cell centres as
+    // segment_regions measures it.
+    const double di = static_cast<double>(static_cast<std::int64_t>(o % grid.cols) - bi);
+    const double dj = static_cast<double>(static_cast<std::int64_t>(o / grid.cols) - bj);
+    const bool near = di * di + dj * dj < completed_radius_cells2_;
+    if (r == Region::kUnscanned) {
+      ++unscanned;
+      unscanned_near += near;
+    } else if (near) {
+      ++low_resolution;
+    }
+  }
+  ScanGain g;
+  g.unscanned_m2 = unscanned * regions_.cell_area_m2();
+  g.low_resolution_m2 = low_resolution * regions_.cell_area_m2();
+  g.completed_m2 = (unscanned_near + low_resolution) * regions_.cell_area_m2();
+  g.f = alpha_ * g.unscanned_m2 + (1 - alpha_) * g.low_resolution_m2;
+  return g;
+}
+
+ScanGain ScanGainEvaluator::at(CellIndex b, double floor_z) const {
+  auto ws = workspace();
+  return at(b, floor_z, ws);
+}
+
+}  // namespace scanplan

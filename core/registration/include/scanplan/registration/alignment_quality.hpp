@@ -1,0 +1,40 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstddef>
+
+#include "scanplan/geometry/point_cloud.hpp"
+#include "scanplan/registration/registration_result.hpp"
+
+namespace scanplan {
+
+// How well a source cloud sits on a target cloud under a transform, judged the same way for
+// every matching method so that their results compare.
+struct AlignmentQuality {
+  // Paper Eq. 2: Σ_j ‖m_i − (R·d_j + t)‖² over source points d_j with m_i the closest target
+  // point, each term truncated at score_max_distance² (see evaluate_alignment).
+  double score = 0;
+  double rmse = 0;          // over inliers only
+  double inlier_ratio = 0;  // inliers / points
+  std::size_t inliers = 0;  // source points with a target point within inlier_distance
+  std::size_t points = 0;   // source points scored
+  // How firmly the inliers pin the pose down in its weakest direction: the smallest eigenvalue
+  // of the point-to-plane information matrix Σ a·aᵀ / inliers, a = [n; (p×n)/L] over the
+  // parameters of `dof` (n the target's surface normal at the match, L the RMS radius of the
+  // inliers, so rotation and translation weigh alike). Roughly the share of inliers that
+  // constrain that direction: near 0 in a corridor (nothing stops sliding along it) or on open
+  // ground, a few per cent and more where walls face several ways.
+  double weakest_constraint = 0;
+};
+
+// Scores `source` moved by `source_to_target` against `target`. The paper does not say how
+// Eq. 2 treats points seen by one scan only; without a cut they dominate the sum and the score
+// says more about the overlap than about the match, so each term is min(d², score_max²).
+// `weakest_constraint` needs a surface normal per inlier, which costs as much as the rest: it is
+// left at 0 unless `with_constraint`.
+AlignmentQuality evaluate_alignment(const PointCloud& target, const PointCloud& source,
+                                    const Eigen::Isometry3d& source_to_target, Dof dof,
+                                    double score_max_distance_m, double inlier_distance_m,
+                                    bool with_constraint = true);
+
+}  // namespace scanplan

@@ -1,0 +1,33 @@
+#pragma once
+
+#include "scanplan/geometry/pose.hpp"
+#include "scanplan/registration/registration.hpp"
+
+namespace scanplan {
+
+struct MapMatchConfig {
+  Method method = Method::kNdtIcp;  // paper §4.3: narrower NDT, then line-segment ICP
+  RegistrationConfig registration;
+  // Map points farther than this from the reported position cannot overlap the new scan much,
+  // and only slow the match down.
+  double target_radius_m = 60.0;
+  // A correction larger than this is not believed even when the solver converged: the pose
+  // sensors are not that wrong (DESIGN.md: σ 1 m, 5°), so it would be a false match.
+  double max_correction_m = 6.0;
+  double max_correction_deg = 25.0;
+};
+
+struct MapMatch {
+  Pose placed;  // where the scan goes in the map: corrected, or the reported pose on failure
+  RegistrationResult result;
+  bool applied = false;  // whether `placed` is the matcher's correction
+};
+
+// The pipeline hook of paper §4: the new scan (its own frame) matched against the map built so
+// far (map frame), starting from the reported pose. The match runs in a levelled frame at the
+// reported position, so the 4-DOF solver turns about the true vertical and keeps the measured
+// roll and pitch.
+MapMatch match_to_map(const PointCloud& map_points, const PointCloud& scan, const Pose& reported,
+                      const MapMatchConfig& config = {});
+
+}  // namespace scanplan

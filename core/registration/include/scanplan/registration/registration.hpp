@@ -1,0 +1,107 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string_view>
+
+#include "scanplan/geometry/point_cloud.hpp"
+#include "scanplan/registration/line_segment_icp.hpp"
+#include "scanplan/registration/narrower_ndt.hpp"
+#include "scanplan/registration/registration_result.hpp"
+
+namespace scanplan {
+
+// Scan matching (paper §4, DESIGN.md "Scan matching"). PCL's matchers, the baselines, live in
+// scanplan_registration_pcl and go through the same register_with, so that they run on the same
+// input and are scored the same way.
+enum class Method {
+  kNdtIcp,  // narrower NDT, then line-segment ICP (paper §4.3): the default
+  kNdt,     // narrower NDT alone (§4.2)
+  kIcp,     // line-segment ICP alone (§4.1)
+};
+
+// "ndt-icp", "ndt", "icp"; nullopt for anything else.
+std::optional<Method> parse_method(std::string_view name);
+std::string_view method_name(Method method);
+
+// Everything a match can be tuned by, as plain data. Lengths are for outdoor scans like the
+// paper's (tens of metres); with adapt_to_scene they shrink for shorter-range data.
+// IcpConfig: the source is thinned further, to 0.75 m, for speed: on the campus benchmark that
+// costs no success and a third of the ICP time against 0.5 m.
+struct RegistrationConfig {
+  Dof dof = Dof::k4;  // paper §4.3: the inclination sensor fixes roll and pitch
+  // Both clouds are first thinned to one point per cube of this side (voxel_downsample; 0: not
+  // thinned), so that every method sees the same points and the dense ground at the scanner's
+  // feet does not outweigh the walls.
+  double voxel_m = 0.25;
+  // Fit the lengths to the scene, measured as scene_range_m() of the target (before thinning):
+  //  - NDT cells: the paper's 20/15/10 m (§4.2) are taken to suit a scene range of
+  //    paper_scene_range_m and are scaled by min(1, range / paper_scene_range_m). Our simulated
+  //    campus scans (range 13–22 m) get 5–9 m first cells; with the paper's cells as they are,
+  //    the coarse Gaussians average what one scan sees of a 20 m cube against what the other
+  //    sees and the optimum lands metres off (docs/benchmarks.md). The 3DTK sample (range
+  //    6–8 m) gets 2.4–3.3 m.
+  //  - every other length (voxel, ICP distances, the baselines' settings, score and sanity
+  //    distances) is
+  //    tuned for the campus and scaled by min(1, range / reference_scene_range_m).
+  bool adapt_to_scene = true;
+  double paper_scene_range_m = 50.0;
+  double reference_scene_range_m = 12.0;
+
+  NdtConfig ndt;
+  IcpConfig icp{.source_voxel_m = 0.75};
+
+  // Eq. 2 score: each squared distance is truncated at this (see evaluate_alignment).
+  double score_max_distance_m = 1.0;
+  // The sanity check behind `converged`: a solver that stopped on its tolerances has still
+  // failed when too few source points found a target point within inlier_distance_m (the
+  // clouds do not overlap, or the match is wrong), or when the matched surfaces do not pin the
+  // pose down in every direction (AlignmentQuality::weakest_constraint below min_constraint: a
+  // corridor or a single wall, along which any position fits as well as the true one).
+  double inlier_distance_m = 0.3;
+  double min_inlier_ratio = 0.2;
+  double min_constraint = 0.01;
+  // Fewer points than this in either cloud after thinning: no match is attempted.
+  std::size_t min_points = 30;
+};
+
+// How far the scanner sees in `cloud`, whose origin is taken as the sensor: the 90th percentile
+// of the point ranges. (Not the median: a scanner whose fan sweeps the ground at its feet puts
+// half its points within a couple of metres even on an open campus.) 0 for an empty cloud.
+double scene_range_m(const PointCloud& cloud);
+
+// `config` with every length but the NDT cell sizes multiplied by `factor`.
+RegistrationConfig scale_lengths(const RegistrationConfig& config, double factor);
+
+// The factor every length but the NDT cells is scaled by for this target (1 unless
+// adapt_to_scene).
+double length_scale(const PointCloud& target, const RegistrationConfig& config);
+
+// The configuration register_scans actually uses for this target: scaled when adapt_to_scene.
+RegistrationConfig adapted_config(const PointCloud& target, const RegistrationConfig& config);
+
+// One alignment of clouds already thinned, with the configuration already adapted to the scene
+// (`length_scale` is the factor it was adapted by): the part that differs between methods.
+// Fills transform, iterations, converged and message.
+using Aligner = std::function<RegistrationResult(
+    const PointCloud& target, const PointCloud& source, const Eigen::Isometry3d& initial,
+    const RegistrationConfig& adapted, double length_scale)>;
+
+// What every method shares around its alignment: the input checks, the scene adaptation, the
+// thinning, the timing, the Eq. 2 score and the sanity check behind `converged`. `method` names
+// the result.
+RegistrationResult register_with(const PointCloud& target, const PointCloud& source,
+                                 const Eigen::Isometry3d& initial, std::string_view method,
+                                 const Aligner& align, const RegistrationConfig& config = {});
+
+// Finds the transform that maps `source` into `target`, starting from `initial`. Bad input
+// (an empty cloud, too few points, a non-finite initial transform, clouds that do not overlap)
+// is not an exception: it gives converged = false with the reason in `message`, and never a
+// wrong pose marked converged as far as the sanity check can tell.
+RegistrationResult register_scans(const PointCloud& target, const PointCloud& source,
+                                  const Eigen::Isometry3d& initial, Method method = Method::kNdtIcp,
+                                  const RegistrationConfig& config = {});
+
+}  // namespace scanplan

@@ -1,0 +1,47 @@
+#include "scanplan/registration/map_matcher.hpp"
+
+#include <cmath>
+
+namespace scanplan {
+
+MapMatch match_to_map(const PointCloud& map_points, const PointCloud& scan, const Pose& reported,
+                      const MapMatchConfig& config) {
+  MapMatch out;
+  out.placed = reported;
+  // The levelled frame: at the reported position, turned by the reported yaw, z vertical.
+  Pose level_pose;
+  level_pose.x = reported.x;
+  level_pose.y = reported.y;
+  level_pose.z = reported.z;
+  level_pose.yaw = reported.yaw;
+  const Eigen::Isometry3d map_from_level = level_pose.isometry();
+  const Eigen::Isometry3f level_from_map = map_from_level.inverse().cast<float>();
+
+  PointCloud target;
+  const float r2 = static_cast<float>(config.target_radius_m * config.target_radius_m);
+  const Eigen::Vector2f center(static_cast<float>(reported.x), static_cast<float>(reported.y));
+  for (const auto& p : map_points.points) {
+    if ((p.head<2>() - center).squaredNorm() <= r2) target.points.push_back(level_from_map * p);
+  }
+  const Eigen::Isometry3d initial = map_from_level.inverse() * reported.isometry();
+  out.result = register_scans(target, scan, initial, config.method, config.registration);
+  if (!out.result.converged) return out;
+
+  const Eigen::Isometry3d placed = map_from_level * out.result.transform;
+  const Pose corrected = Pose::from_isometry(placed);
+  const double shift = std::hypot(std::hypot(corrected.x - reported.x, corrected.y - reported.y),
+                                  corrected.z - reported.z);
+  const double turn = std::abs(std::remainder(corrected.yaw - reported.yaw, 2 * M_PI));
+  if (shift > config.max_correction_m || rad2deg(turn) > config.max_correction_deg) {
+    out.result.converged = false;
+    out.result.message = "the match moved the scan " + std::to_string(shift) + " m and " +
+                         std::to_string(rad2deg(turn)) +
+                         "°, more than the pose sensors can be wrong: not applied";
+    return out;
+  }
+  out.placed = corrected;
+  out.applied = true;
+  return out;
+}
+
+}  // namespace scanplan

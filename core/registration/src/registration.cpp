@@ -1,0 +1,178 @@
+#include "scanplan/registration/registration.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "scanplan/geometry/voxel_filter.hpp"
+#include "scanplan/registration/alignment_quality.hpp"
+#include "scanplan/registration/ndt_icp.hpp"
+
+namespace scanplan {
+namespace {
+
+constexpr std::array<std::pair<Method, std::string_view>, 3> kNames{{
+    {Method::kNdtIcp, "ndt-icp"},
+    {Method::kNdt, "ndt"},
+    {Method::kIcp, "icp"},
+}};
+
+std::string metres(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g m", v);
+  return buf;
+}
+
+RegistrationResult failed(std::string_view method, std::string message) {
+  RegistrationResult r;
+  r.method = std::string(method);
+  r.message = std::move(message);
+  return r;
+}
+
+RegistrationResult align_ours(const PointCloud& target, const PointCloud& source,
+                              const Eigen::Isometry3d& initial, Method method,
+                              const RegistrationConfig& c) {
+  switch (method) {
+    case Method::kNdtIcp:
+      return align_ndt_icp(target, source, initial, c.dof, c.ndt, c.icp);
+    case Method::kNdt:
+      return align_narrower_ndt(target, source, initial, c.dof, c.ndt);
+    case Method::kIcp:
+      return align_line_segment_icp(target, source, initial, c.dof, c.icp);
+  }
+  return failed(method_name(method), "unknown method");
+}
+
+}  // namespace
+
+std::optional<Method> parse_method(std::string_view name) {
+  for (const auto& [method, text] : kNames) {
+    if (text == name) return method;
+  }
+  return std::nullopt;
+}
+
+std::string_view method_name(Method method) {
+  for (const auto& [m, text] : kNames) {
+    if (m == method) return text;
+  }
+  return "unknown";
+}
+
+double scene_range_m(const PointCloud& cloud) {
+  std::vector<float> ranges;
+  ranges.reserve(cloud.size());
+  for (const auto& p : cloud.points) {
+    if (p.allFinite()) ranges.push_back(p.norm());
+  }
+  if (ranges.empty()) return 0;
+  const auto at = ranges.begin() + static_cast<std::ptrdiff_t>(0.9 * (ranges.size() - 1));
+  std::nth_element(ranges.begin(), at, ranges.end());
+  return *at;
+}
+
+RegistrationConfig scale_lengths(const RegistrationConfig& config, double factor) {
+  RegistrationConfig c = config;
+  c.voxel_m *= factor;
+  c.icp.max_correspondence_m *= factor;
+  c.icp.min_correspondence_m *= factor;
+  c.icp.source_voxel_m *= factor;
+  c.icp.translation_tolerance_m *= factor;
+  c.score_max_distance_m *= factor;
+  c.inlier_distance_m *= factor;
+  // NDT's tolerances and step bounds are already relative to the cell size.
+  return c;
+}
+
+namespace {
+
+// Below a hundredth of the outdoor scale the data is something else (a table-top scan); the
+// floor keeps lengths from collapsing to nothing on a handful of points.
+double scale_for(const PointCloud& target, const RegistrationConfig& config, double reference) {
+  if (!config.adapt_to_scene || !(reference > 0)) return 1.0;
+  const double range = scene_range_m(target);
+  if (!(range > 0)) return 1.0;
+  return std::clamp(range / reference, 0.01, 1.0);
+}
+
+}  // namespace
+
+double length_scale(const PointCloud& target, const RegistrationConfig& config) {
+  return scale_for(target, config, config.reference_scene_range_m);
+}
+
+RegistrationConfig adapted_config(const PointCloud& target, const RegistrationConfig& config) {
+  RegistrationConfig c = scale_lengths(config, length_scale(target, config));
+  const double cells = scale_for(target, config, config.paper_scene_range_m);
+  for (double& cell : c.ndt.cell_sizes_m) cell *= cells;
+  return c;
+}
+
+RegistrationResult register_scans(const PointCloud& target, const PointCloud& source,
+                                  const Eigen::Isometry3d& initial, Method method,
+                                  const RegistrationConfig& config) {
+  return register_with(
+      target, source, initial, method_name(method),
+      [method](const PointCloud& t, const PointCloud& s, const Eigen::Isometry3d& start,
+               const RegistrationConfig& c, double) { return align_ours(t, s, start, method, c); },
+      config);
+}
+
+RegistrationResult register_with(const PointCloud& target, const PointCloud& source,
+                                 const Eigen::Isometry3d& initial, std::string_view method,
+                                 const Aligner& align, const RegistrationConfig& config) {
+  if (target.empty()) return failed(method, "the target cloud is empty");
+  if (source.empty()) return failed(method, "the source cloud is empty");
+  if (!initial.matrix().allFinite()) {
+    return failed(method, "the initial transform is not finite");
+  }
+  const double scale = length_scale(target, config);
+  const RegistrationConfig c = adapted_config(target, config);
+  const PointCloud t = voxel_downsample(target, c.voxel_m);
+  const PointCloud s = voxel_downsample(source, c.voxel_m);
+  const std::size_t need = std::max<std::size_t>(c.min_points, 1);
+  if (t.size() < need || s.size() < need) {
+    return failed(method, "too few points to match: target " + std::to_string(t.size()) +
+                              ", source " + std::to_string(s.size()) + " after thinning to " +
+                              metres(c.voxel_m) + " voxels (at least " + std::to_string(need) +
+                              " each are needed)");
+  }
+
+  const auto started = std::chrono::steady_clock::now();
+  RegistrationResult r = align(t, s, initial, c, scale);
+  r.time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+  r.method = std::string(method);
+
+  const AlignmentQuality q =
+      evaluate_alignment(t, s, r.transform, c.dof, c.score_max_distance_m, c.inlier_distance_m,
+                         /*with_constraint=*/r.converged);
+  r.score = q.score;
+  r.rmse = q.rmse;
+  r.inlier_ratio = q.inlier_ratio;
+  if (r.converged && q.inlier_ratio < c.min_inlier_ratio) {
+    r.converged = false;
+    r.message = "only " + std::to_string(static_cast<int>(q.inlier_ratio * 100 + 0.5)) +
+                "% of the source points lie within " + metres(c.inlier_distance_m) +
+                " of the target (at least " +
+                std::to_string(static_cast<int>(c.min_inlier_ratio * 100 + 0.5)) +
+                "% needed): the scans do not overlap enough, or the match is wrong";
+  } else if (r.converged && q.weakest_constraint < c.min_constraint) {
+    r.converged = false;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.4f (at least %.4f needed)", q.weakest_constraint,
+                  c.min_constraint);
+    r.message = std::string(
+                    "the matched surfaces leave the pose nearly free in one direction "
+                    "(weakest constraint ") +
+                buf + "): a corridor or a single wall, along which the match cannot be trusted";
+  }
+  return r;
+}
+
+}  // namespace scanplan

@@ -1,0 +1,340 @@
+#include "storage/session_store.hpp"
+
+#include <fcntl.h>
+#include <sqlite3.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <ctime>
+#include <set>
+
+#include "scanplan/io/ply_io.hpp"
+
+namespace scanplan {
+namespace {
+
+std::string utc_iso(std::chrono::system_clock::time_point now) {
+  const std::time_t t = std::chrono::system_clock::to_time_t(now);
+  const auto ms =
+      std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[40];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &tm);
+  char out[48];
+  std::snprintf(out, sizeof out, "%s.%03dZ", buf, static_cast<int>(ms));
+  return out;
+}
+
+std::string utc_now() {
+  return utc_iso(std::chrono::system_clock::now());
+}
+
+// Writes `bytes` to `path` so that after return the file is whole on disk under its name:
+// temporary file, fsync, rename, fsync of the directory.
+void write_durably(const std::filesystem::path& path, const std::string& bytes) {
+  const std::filesystem::path part = path.string() + ".part";
+  const int fd = ::open(part.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0)
+    throw SessionStoreError("cannot create " + part.string() + ": " + std::strerror(errno));
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const std::string why = std::strerror(errno);
+      ::close(fd);
+      throw SessionStoreError("cannot write " + part.string() + ": " + why);
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+    throw SessionStoreError("cannot sync " + part.string() + ": " + std::strerror(errno));
+  }
+  std::filesystem::rename(part, path);
+  const int dir = ::open(path.parent_path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir >= 0) {
+    ::fsync(dir);
+    ::close(dir);
+  }
+}
+
+class Statement {
+ public:
+  Statement(sqlite3* db, const char* sql) : db_(db) {
+    if (sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr) != SQLITE_OK) {
+      throw SessionStoreError(std::string("session database: ") + sqlite3_errmsg(db));
+    }
+  }
+  ~Statement() { sqlite3_finalize(stmt_); }
+  Statement& bind(int i, double v) { return check(sqlite3_bind_double(stmt_, i, v)); }
+  Statement& bind(int i, std::int64_t v) { return check(sqlite3_bind_int64(stmt_, i, v)); }
+  Statement& bind(int i, const std::string& v) {
+    return check(
+        sqlite3_bind_text(stmt_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT));
+  }
+  bool step() {
+    const int rc = sqlite3_step(stmt_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) return false;
+    throw SessionStoreError(std::string("session database: ") + sqlite3_errmsg(db_));
+  }
+  double real(int col) const { return sqlite3_column_double(stmt_, col); }
+  std::int64_t integer(int col) const { return sqlite3_column_int64(stmt_, col); }
+  std::string text(int col) const {
+    const auto* t = sqlite3_column_text(stmt_, col);
+    return t ? reinterpret_cast<const char*>(t) : "";
+  }
+
+ private:
+  Statement& check(int rc) {
+    if (rc != SQLITE_OK)
+      throw SessionStoreError(std::string("session database: ") + sqlite3_errmsg(db_));
+    return *this;
+  }
+  sqlite3* db_;
+  sqlite3_stmt* stmt_ = nullptr;
+};
+
+constexpr const char* kScanColumns =
+    "id, robot, est_x, est_y, est_z, est_roll, est_pitch, est_yaw, x, y, z, roll, pitch, yaw, "
+    "stamp_ns, points, file, received_at";
+
+StoredScan scan_from_row(const Statement& s) {
+  StoredScan r;
+  r.id = s.integer(0);
+  r.robot = s.text(1);
+  r.estimated = {s.real(2), s.real(3), s.real(4), s.real(5), s.real(6), s.real(7)};
+  r.placed = {s.real(8), s.real(9), s.real(10), s.real(11), s.real(12), s.real(13)};
+  r.stamp_ns = s.integer(14);
+  r.points = static_cast<std::size_t>(s.integer(15));
+  r.file = s.text(16);
+  r.received_at = s.text(17);
+  return r;
+}
+
+}  // namespace
+
+SessionStore::SessionStore(std::filesystem::path dir) : dir_(std::move(dir)) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir_ / "scans", ec);
+  if (ec)
+    throw SessionStoreError("cannot create the session directory " + dir_.string() + ": " +
+                            ec.message());
+  const std::string db_path = (dir_ / "session.sqlite").string();
+  if (sqlite3_open_v2(db_path.c_str(), &db_,
+                      SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
+                      nullptr) != SQLITE_OK) {
+    const std::string why = db_ ? sqlite3_errmsg(db_) : "out of memory";
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw SessionStoreError("cannot open " + db_path + ": " + why);
+  }
+  sqlite3_busy_timeout(db_, 5000);
+  // WAL with full sync: a commit is on disk when it returns, and readers never block the writer.
+  exec("PRAGMA journal_mode=WAL");
+  exec("PRAGMA synchronous=FULL");
+  exec(
+      "CREATE TABLE IF NOT EXISTS scans(id INTEGER PRIMARY KEY, robot TEXT NOT NULL, "
+      "est_x REAL, est_y REAL, est_z REAL, est_roll REAL, est_pitch REAL, est_yaw REAL, "
+      "x REAL, y REAL, z REAL, roll REAL, pitch REAL, yaw REAL, stamp_ns INTEGER, "
+      "points INTEGER, file TEXT NOT NULL, received_at TEXT NOT NULL)");
+  exec(
+      "CREATE TABLE IF NOT EXISTS events(id INTEGER PRIMARY KEY, at TEXT NOT NULL, "
+      "kind TEXT NOT NULL, json TEXT NOT NULL)");
+  // Deleted annotations keep their rows (deleted_at, deleted_by set): what was marked on the map
+  // and withdrawn is part of a rescue's record, and ids are never reused.
+  exec(
+      "CREATE TABLE IF NOT EXISTS annotations(id INTEGER PRIMARY KEY, kind TEXT NOT NULL, "
+      "x REAL NOT NULL, y REAL NOT NULL, z REAL NOT NULL, text TEXT NOT NULL, "
+      "author TEXT NOT NULL, created_ns INTEGER NOT NULL, created_at TEXT NOT NULL, "
+      "deleted_at TEXT, deleted_by TEXT)");
+  remove_orphans();
+}
+
+SessionStore::~SessionStore() {
+  sqlite3_close(db_);
+}
+
+void SessionStore::exec(const char* sql) const {
+  char* err = nullptr;
+  if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
+    const std::string why = err ? err : "unknown error";
+    sqlite3_free(err);
+    throw SessionStoreError("session database (" + dir_.string() + "): " + why);
+  }
+}
+
+void SessionStore::remove_orphans() const {
+  std::set<std::string> known;
+  Statement s(db_, "SELECT file FROM scans");
+  while (s.step()) known.insert(s.text(0));
+  for (const auto& entry : std::filesystem::directory_iterator(dir_ / "scans")) {
+    const std::string rel = "scans/" + entry.path().filename().string();
+    if (!known.count(rel)) std::filesystem::remove(entry.path());
+  }
+}
+
+StoredScan SessionStore::add_scan(const std::string& robot, const Pose& estimated,
+                                  const Pose& placed, std::int64_t stamp_ns,
+                                  const PointCloud& cloud) {
+  std::lock_guard lock(mutex_);
+  exec("BEGIN IMMEDIATE");
+  try {
+    StoredScan r;
+    {
+      Statement next(db_, "SELECT COALESCE(MAX(id), 0) + 1 FROM scans");
+      next.step();
+      r.id = next.integer(0);
+    }
+    char name[48];
+    std::snprintf(name, sizeof name, "scans/scan_%06lld.ply", static_cast<long long>(r.id));
+    r.robot = robot;
+    r.estimated = estimated;
+    r.placed = placed;
+    r.stamp_ns = stamp_ns;
+    r.points = cloud.size();
+    r.file = name;
+    r.received_at = utc_now();
+    write_durably(dir_ / r.file, write_ply_bytes(cloud, {"scanplan robot " + robot}));
+    Statement ins(db_, (std::string("INSERT INTO scans(") + kScanColumns +
+                        ") VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)")
+                           .c_str());
+    const Pose& e = estimated;
+    const Pose& p = placed;
+    ins.bind(1, r.id).bind(2, robot);
+    ins.bind(3, e.x).bind(4, e.y).bind(5, e.z).bind(6, e.roll).bind(7, e.pitch).bind(8, e.yaw);
+    ins.bind(9, p.x).bind(10, p.y).bind(11, p.z).bind(12, p.roll).bind(13, p.pitch).bind(14, p.yaw);
+    ins.bind(15, stamp_ns).bind(16, static_cast<std::int64_t>(r.points)).bind(17, r.file);
+    ins.bind(18, r.received_at);
+    ins.step();
+    exec("COMMIT");
+    return r;
+  } catch (...) {
+    exec("ROLLBACK");
+    throw;
+  }
+}
+
+void SessionStore::set_placed(std::int64_t id, const Pose& p) {
+  std::lock_guard lock(mutex_);
+  Statement s(db_,
+              "UPDATE scans SET x = ?, y = ?, z = ?, roll = ?, pitch = ?, yaw = ? WHERE id = ?");
+  s.bind(1, p.x).bind(2, p.y).bind(3, p.z).bind(4, p.roll).bind(5, p.pitch).bind(6, p.yaw);
+  s.bind(7, id);
+  s.step();
+}
+
+std::vector<StoredScan> SessionStore::scans() const {
+  std::lock_guard lock(mutex_);
+  std::vector<StoredScan> out;
+  Statement s(db_, (std::string("SELECT ") + kScanColumns + " FROM scans ORDER BY id").c_str());
+  while (s.step()) out.push_back(scan_from_row(s));
+  return out;
+}
+
+std::vector<SessionEvent> SessionStore::events(std::size_t limit) const {
+  std::lock_guard lock(mutex_);
+  std::vector<SessionEvent> out;
+  Statement s(db_,
+              "SELECT id, at, kind, json FROM (SELECT id, at, kind, json FROM events "
+              "ORDER BY id DESC LIMIT ?) ORDER BY id");
+  s.bind(1, static_cast<std::int64_t>(limit));
+  while (s.step()) out.push_back({s.integer(0), s.text(1), s.text(2), s.text(3)});
+  return out;
+}
+
+std::optional<StoredScan> SessionStore::scan(std::int64_t id) const {
+  std::lock_guard lock(mutex_);
+  Statement s(db_, (std::string("SELECT ") + kScanColumns + " FROM scans WHERE id = ?").c_str());
+  s.bind(1, id);
+  if (!s.step()) return std::nullopt;
+  return scan_from_row(s);
+}
+
+PointCloud SessionStore::load_points(const StoredScan& scan) const {
+  return read_ply(dir_ / scan.file);
+}
+
+std::int64_t SessionStore::append_event(const std::string& kind, const std::string& json) {
+  std::lock_guard lock(mutex_);
+  Statement s(db_, "INSERT INTO events(at, kind, json) VALUES(?, ?, ?)");
+  s.bind(1, utc_now()).bind(2, kind).bind(3, json);
+  s.step();
+  return sqlite3_last_insert_rowid(db_);
+}
+
+Annotation SessionStore::add_annotation(const std::string& kind, double x, double y, double z,
+                                        const std::string& text, const std::string& author) {
+  if (std::find(kAnnotationKinds.begin(), kAnnotationKinds.end(), kind) == kAnnotationKinds.end()) {
+    throw SessionStoreError("unknown annotation kind '" + kind +
+                            "': it is victim, hazard, blocked or note");
+  }
+  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+    throw SessionStoreError("an annotation's coordinates must be finite numbers");
+  }
+  if (text.size() > kMaxAnnotationTextBytes || author.size() > kMaxAnnotationAuthorBytes) {
+    throw SessionStoreError("an annotation's text is limited to " +
+                            std::to_string(kMaxAnnotationTextBytes) + " bytes and its author to " +
+                            std::to_string(kMaxAnnotationAuthorBytes));
+  }
+  const auto now = std::chrono::system_clock::now();
+  Annotation a;
+  a.kind = kind;
+  a.x = x;
+  a.y = y;
+  a.z = z;
+  a.text = text;
+  a.author = author;
+  a.created_ns =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(now.time_since_epoch()).count();
+  a.created_at = utc_iso(now);
+  std::lock_guard lock(mutex_);
+  // One statement in autocommit mode: with WAL and synchronous=FULL it is durable on return.
+  Statement s(db_,
+              "INSERT INTO annotations(kind, x, y, z, text, author, created_ns, created_at) "
+              "VALUES(?, ?, ?, ?, ?, ?, ?, ?)");
+  s.bind(1, kind).bind(2, x).bind(3, y).bind(4, z).bind(5, text).bind(6, author);
+  s.bind(7, a.created_ns).bind(8, a.created_at);
+  s.step();
+  a.id = sqlite3_last_insert_rowid(db_);
+  return a;
+}
+
+bool SessionStore::delete_annotation(std::int64_t id, const std::string& by) {
+  std::lock_guard lock(mutex_);
+  Statement s(db_,
+              "UPDATE annotations SET deleted_at = ?, deleted_by = ? "
+              "WHERE id = ? AND deleted_at IS NULL");
+  s.bind(1, utc_now()).bind(2, by).bind(3, id);
+  s.step();
+  return sqlite3_changes(db_) > 0;
+}
+
+std::vector<Annotation> SessionStore::annotations() const {
+  std::lock_guard lock(mutex_);
+  std::vector<Annotation> out;
+  Statement s(db_,
+              "SELECT id, kind, x, y, z, text, author, created_ns, created_at FROM annotations "
+              "WHERE deleted_at IS NULL ORDER BY id");
+  while (s.step()) {
+    Annotation a;
+    a.id = s.integer(0);
+    a.kind = s.text(1);
+    a.x = s.real(2);
+    a.y = s.real(3);
+    a.z = s.real(4);
+    a.text = s.text(5);
+    a.author = s.text(6);
+    a.created_ns = s.integer(7);
+    a.created_at = s.text(8);
+    out.push_back(std::move(a));
+  }
+  return out;
+}
+
+}  // namespace scanplan

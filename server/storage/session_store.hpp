@@ -1,0 +1,113 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "scanplan/geometry/point_cloud.hpp"
+#include "scanplan/geometry/pose.hpp"
+
+struct sqlite3;
+
+namespace scanplan {
+
+class SessionStoreError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct StoredScan {
+  std::int64_t id = 0;
+  std::string robot;
+  Pose estimated;  // the pose the robot reported
+  Pose placed;     // where the map put the scan (after matching)
+  std::int64_t stamp_ns = 0;
+  std::size_t points = 0;
+  std::string file;         // the scan's PLY, relative to the session directory
+  std::string received_at;  // UTC, ISO 8601
+};
+
+// One row of the session's record of what happened (append_event).
+struct SessionEvent {
+  std::int64_t id = 0;
+  std::string at;  // UTC, ISO 8601 with milliseconds
+  std::string kind;
+  std::string json;
+};
+
+// A mark the operator put on the map (DESIGN.md "REST": annotations).
+struct Annotation {
+  std::int64_t id = 0;
+  std::string kind;            // one of kAnnotationKinds
+  double x = 0, y = 0, z = 0;  // map frame, metres
+  std::string text;
+  std::string author;           // who made it, as decisions record it ("operator", "operator Ann")
+  std::int64_t created_ns = 0;  // since the epoch
+  std::string created_at;       // the same instant, UTC, ISO 8601
+};
+
+inline constexpr std::array<std::string_view, 4> kAnnotationKinds = {"victim", "hazard", "blocked",
+                                                                     "note"};
+// Enough for a short report ("two adults, one trapped under the stairs, responsive"); a longer
+// text is a document, not a mark on a map.
+inline constexpr std::size_t kMaxAnnotationTextBytes = 1000;
+inline constexpr std::size_t kMaxAnnotationAuthorBytes = 100;
+
+// A session on disk (DESIGN.md "Session directory"): session.sqlite in WAL mode plus one binary
+// PLY per scan under scans/. A scan is acknowledged only once both are durable: the PLY is
+// written to a temporary name, synced and renamed before its row commits, so a process killed
+// at any moment leaves either the whole scan or none of it (an orphaned PLY without its row is
+// ignored and removed on the next open). Safe to use from several threads.
+class SessionStore {
+ public:
+  // Opens or creates the session in `dir`; throws SessionStoreError naming the path.
+  explicit SessionStore(std::filesystem::path dir);
+  ~SessionStore();
+  SessionStore(const SessionStore&) = delete;
+  SessionStore& operator=(const SessionStore&) = delete;
+
+  const std::filesystem::path& dir() const { return dir_; }
+
+  // `cloud` in the scan's own frame. Returns the new scan with its id.
+  StoredScan add_scan(const std::string& robot, const Pose& estimated, const Pose& placed,
+                      std::int64_t stamp_ns, const PointCloud& cloud);
+  // Records where matching placed scan `id` in the map.
+  void set_placed(std::int64_t id, const Pose& placed);
+  std::vector<StoredScan> scans() const;
+  // The newest `limit` events recorded with append_event, oldest first.
+  std::vector<SessionEvent> events(std::size_t limit) const;
+  std::optional<StoredScan> scan(std::int64_t id) const;
+  PointCloud load_points(const StoredScan& scan) const;
+
+  // A key-value record of what happened (decisions, events), in order, as JSON text.
+  std::int64_t append_event(const std::string& kind, const std::string& json);
+
+  // Stores a new annotation, committed (on disk) when this returns, and returns it with its id
+  // and creation time. Ids are never reused, even after a deletion. Throws SessionStoreError for
+  // an unknown kind, a non-finite coordinate or a text or author over the limits, so nothing
+  // invalid is ever stored.
+  Annotation add_annotation(const std::string& kind, double x, double y, double z,
+                            const std::string& text, const std::string& author);
+  // Marks annotation `id` deleted by `by` (the row stays, for the record); false when there is
+  // no such annotation or it was already deleted.
+  bool delete_annotation(std::int64_t id, const std::string& by);
+  // The annotations not deleted, oldest first.
+  std::vector<Annotation> annotations() const;
+
+ private:
+  void exec(const char* sql) const;
+  void remove_orphans() const;
+
+  std::filesystem::path dir_;
+  sqlite3* db_ = nullptr;
+  // One connection, so one writer at a time: a transaction spans several calls.
+  mutable std::mutex mutex_;
+};
+
+}  // namespace scanplan

@@ -1,0 +1,33 @@
+#include <gtest/gtest.h>
+
+#include "mapping_test_support.hpp"
+#include "scanplan/mapping/movable_region.hpp"
+#include "scanplan/mapping/region_segmentation.hpp"
+#include "scanplan/mapping/top_view.hpp"
+
+namespace scanplan {
+namespace {
+
+using test::slab;
+
+TEST(TopView, LayersHaveTheTargetsShapeAndColours) {
+  MlsMap map;
+  map.insert(slab(0, 30, 0, 10, 0.0f));
+  const RegionMap r = segment_regions(map, TargetRegion::rectangle({0, 0}, {40, 10}), {{0.5, 0.5}});
+  const MovableRegion m = movable_region(map, {0.5, 0.5, 0.0});
+  TopViewStyle style;
+  style.px_per_cell = 2;
+  const cv::Mat img = render_regions(r, &m, {{0.5, 0.5}}, style);
+  EXPECT_EQ(img.cols, r.cells.cols * 2);
+  EXPECT_EQ(img.rows, r.cells.rows * 2);
+  // Cell (25, 5): low resolution and movable → yellow (BGR 64, 208, 236); north is up.
+  const cv::Vec3b px = img.at<cv::Vec3b>((r.cells.rows - 1 - 5) * 2, 25 * 2);
+  EXPECT_EQ(px, cv::Vec3b(64, 208, 236));
+  const auto png = encode_png(render_elevation(map, r, style));
+  ASSERT_GT(png.size(), 8u);
+  EXPECT_EQ(png[1], 'P');
+  EXPECT_EQ(encode_png(render_movable(map, m, r, style))[2], 'N');
+}
+
+}  // namespace
+}  // namespace scanplan

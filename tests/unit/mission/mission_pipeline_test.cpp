@@ -1,0 +1,135 @@
+// The paper's loop as one object: a scan is placed (matched against the map so far), mapped,
+// segmented and planned from, on the yard world with known true poses.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "scanplan/mission/mission_pipeline.hpp"
+#include "scanplan/sim/simulated_scanner.hpp"
+
+namespace scanplan {
+namespace {
+
+class MissionPipelineTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    world_ = new World(load_world(SCANPLAN_SOURCE_DIR "/samples/worlds/yard.json"));
+    world_->scanner.rotation_step_deg = 1.0;  // a quarter of the points: quick, still matchable
+    caster_ = new RayCaster(*world_);
+  }
+  static void TearDownTestSuite() {
+    delete caster_;
+    delete world_;
+  }
+  static PointCloud scan_at(const Pose& truth, std::uint64_t seed) {
+    return simulate_scan(*caster_, world_->scanner, truth, seed);
+  }
+  static MissionConfig config() {
+    MissionConfig c;
+    c.mapping.sensor_height_m = world_->scanner.mount_height_m;
+    c.planner.policy = PlannerPolicy::kExhaustive;
+    return c;
+  }
+  static World* world_;
+  static RayCaster* caster_;
+};
+World* MissionPipelineTest::world_ = nullptr;
+RayCaster* MissionPipelineTest::caster_ = nullptr;
+
+Pose at(double x, double y, double yaw_deg) {
+  Pose p;
+  p.x = x;
+  p.y = y;
+  p.yaw = deg2rad(yaw_deg);
+  return p;
+}
+
+TEST_F(MissionPipelineTest, TheFirstScanDefinesTheMapFrameAndIsNotMatched) {
+  MissionPipeline mission(config());
+  const Pose first = at(-15, -8, 0);
+  const PointCloud cloud = scan_at(first, 1);
+  EXPECT_FALSE(mission.place(cloud, first)) << "nothing to match against yet";
+  EXPECT_FALSE(mission.has_map());
+  const auto placed = mission.add(cloud, first);
+  ASSERT_EQ(placed->size(), cloud.size());
+  EXPECT_TRUE(placed->has_colors());
+  // Points go into the map frame by the pose.
+  EXPECT_NEAR(placed->points[0].x(), cloud.points[0].x() + first.x, 1e-4);
+  EXPECT_TRUE(mission.has_map());
+  EXPECT_EQ(mission.placed_scans().size(), 1u);
+  EXPECT_EQ(mission.mapping().scan_poses().size(), 1u);
+  EXPECT_GT(mission.mapping().regions()->completed_m2(), 100.0);
+  EXPECT_GT(mission.mapping().movable()->area_m2(), 100.0);
+}
+
+TEST_F(MissionPipelineTest, ASecondScanIsPlacedBackOnItsTruePose) {
+  MissionPipeline mission(config());
+  mission.add(scan_at(at(-15, -8, 0), 1), at(-15, -8, 0));
+  const Pose truth = at(-5, -9, 20);
+  Pose reported = truth;
+  reported.x += 0.6;
+  reported.y -= 0.4;
+  reported.yaw += deg2rad(3);
+  const PointCloud second = scan_at(truth, 2);
+  const auto m = mission.place(second, reported);
+  ASSERT_TRUE(m);
+  EXPECT_TRUE(m->applied) << m->result.message;
+  EXPECT_LT(std::hypot(m->placed.x - truth.x, m->placed.y - truth.y), 0.05);
+  EXPECT_LT(std::abs(rad2deg(std::remainder(m->placed.yaw - truth.yaw, 2 * M_PI))), 0.2);
+  EXPECT_EQ(mission.placed_scans().size(), 1u) << "placing changes nothing";
+  mission.add(second, m->placed);
+  EXPECT_EQ(mission.placed_scans().size(), 2u);
+}
+
+TEST_F(MissionPipelineTest, WithMatchingOffScansStayWhereTheRobotSays) {
+  MissionConfig c = config();
+  c.matching.reset();
+  MissionPipeline mission(c);
+  mission.add(scan_at(at(-15, -8, 0), 1), at(-15, -8, 0));
+  EXPECT_FALSE(mission.place(scan_at(at(-5, -9, 0), 2), at(-5, -9, 0)));
+}
+
+TEST_F(MissionPipelineTest, PlansTheNextScanInsideTheMovableRegion) {
+  MissionPipeline mission(config());
+  EXPECT_TRUE(mission.plan_from({-15, -8, 0}, 1).ranked.empty()) << "no map, no plan";
+  mission.set_target(world_->target_region());
+  mission.add(scan_at(at(-15, -8, 0), 1), at(-15, -8, 0));
+  const Plan plan = mission.plan_from({-15, -8, 0}, 1);
+  ASSERT_FALSE(plan.ranked.empty());
+  const MappingPipeline& m = mission.mapping();
+  for (const Candidate& c : plan.ranked) {
+    EXPECT_TRUE(m.target()->contains(c.position.x(), c.position.y()));
+    EXPECT_TRUE(m.movable()->contains(m.map().index_of(c.position.x(), c.position.y())));
+  }
+  // Two robots on one map: one plan each, and not the same best point.
+  const auto plans = mission.plan({{"a", {-15, -8, 0}}, {"b", {-20, 5, 0}}});
+  ASSERT_EQ(plans.size(), 2u);
+  ASSERT_FALSE(plans[0].plan.ranked.empty());
+  ASSERT_FALSE(plans[1].plan.ranked.empty());
+  EXPECT_GT((plans[0].plan.ranked[0].position - plans[1].plan.ranked[0].position).norm(), 1.0);
+}
+
+TEST_F(MissionPipelineTest, PointsNearKeepsTheMapWithinTheRadius) {
+  MissionPipeline mission(config());
+  mission.add(scan_at(at(-15, -8, 0), 1), at(-15, -8, 0));
+  const PointCloud near = mission.points_near(-15, -8, 5);
+  ASSERT_FALSE(near.empty());
+  EXPECT_LT(near.size(), mission.placed_scans()[0]->size());
+  for (const auto& p : near.points) {
+    EXPECT_LE(std::hypot(p.x() + 15, p.y() + 8), 5.0 + 1e-4);
+  }
+}
+
+TEST_F(MissionPipelineTest, NewPlannerThresholdsReachTheSegmentation) {
+  MissionPipeline mission(config());
+  mission.add(scan_at(at(-15, -8, 0), 1), at(-15, -8, 0));
+  const double completed = mission.mapping().regions()->completed_m2();
+  PlannerConfig planner = mission.planner();
+  planner.regions.completed_radius_m = 5;
+  mission.set_planner(planner);
+  EXPECT_LT(mission.mapping().regions()->completed_m2(), completed / 4);
+  EXPECT_EQ(mission.planner().regions.completed_radius_m, 5);
+}
+
+}  // namespace
+}  // namespace scanplan

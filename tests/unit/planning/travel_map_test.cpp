@@ -1,0 +1,62 @@
+#include "scanplan/planning/travel_map.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace scanplan {
+namespace {
+
+std::vector<Eigen::Vector3f> slab(int x0, int x1, int y0, int y1, float z) {
+  std::vector<Eigen::Vector3f> pts;
+  for (int x = x0; x < x1; ++x) {
+    for (int y = y0; y < y1; ++y) {
+      for (int k = 0; k < 4; ++k) pts.emplace_back(x + 0.2f + 0.15f * k, y + 0.3f + 0.1f * k, z);
+    }
+  }
+  return pts;
+}
+
+TEST(TravelMap, StraightStepsCostACellDiagonalsRootTwo) {
+  MlsMap map;
+  map.insert(slab(0, 20, 0, 20, 0.0f));
+  const Eigen::Vector3d robot(2.5, 2.5, 0);
+  const MovableRegion movable = movable_region(map, robot);
+  const TravelMap t = travel_map(map, movable, robot, {});
+  EXPECT_EQ(t.start, (CellIndex{2, 2}));
+  EXPECT_DOUBLE_EQ(t.distance({2, 2}), 0.0);
+  EXPECT_NEAR(t.distance({12, 2}), 10.0, 1e-5);
+  EXPECT_NEAR(t.distance({12, 12}), 10 * std::sqrt(2.0), 1e-4);
+  EXPECT_NEAR(t.distance({12, 7}), 5 + 5 * std::sqrt(2.0), 1e-4);
+  const auto path = t.path_to({12, 7});
+  ASSERT_EQ(path.size(), 11u);
+  EXPECT_EQ(path.front(), Eigen::Vector2d(2.5, 2.5));
+  EXPECT_EQ(path.back(), Eigen::Vector2d(12.5, 7.5));
+  EXPECT_FALSE(t.reachable({30, 30}));
+  EXPECT_TRUE(t.path_to({30, 30}).empty());
+}
+
+TEST(TravelMap, GoesRoundAWallAndNotUpAStep) {
+  MlsMap map;
+  map.insert(slab(0, 20, 0, 20, 0.0f));
+  // A wall at x = 10 from y = 0 to 15: the way from (5, 5) to (15, 5) goes round its end.
+  for (int y = 0; y < 15; ++y) {
+    for (float z = 0; z <= 2.0f; z += 0.25f)
+      map.insert(std::vector<Eigen::Vector3f>{{10.5f, y + 0.5f, z}});
+  }
+  // A platform 0.2 m up beyond x = 20, higher than the robot climbs.
+  map.insert(slab(20, 25, 0, 20, 0.2f));
+  const Eigen::Vector3d robot(5.5, 5.5, 0);
+  const MovableRegion movable = movable_region(map, robot);
+  const TravelMap t = travel_map(map, movable, robot, {});
+  EXPECT_GT(t.distance({15, 5}), 20.0) << "round the wall's end at y = 15";
+  EXPECT_FALSE(t.reachable({22, 5}));
+  // Kept within a target region, the way round leaves it and nothing behind the wall is reached.
+  const TargetRegion below = TargetRegion::rectangle({0, 0}, {20, 14});
+  const TravelMap inside = travel_map(map, movable, robot, {}, &below);
+  EXPECT_FALSE(inside.reachable({15, 5}));
+  EXPECT_TRUE(inside.reachable({5, 12}));
+}
+
+}  // namespace
+}  // namespace scanplan

@@ -1,0 +1,152 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "storage/session_store.hpp"
+
+namespace scanplan {
+namespace {
+
+class SessionDir : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("session_store_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::filesystem::path dir_;
+};
+
+PointCloud cloud_of(int n, float offset) {
+  PointCloud c;
+  for (int i = 0; i < n; ++i) c.push_back({offset + i, 2.0f * i, 0.5f}, {10, 20, 30});
+  return c;
+}
+
+TEST_F(SessionDir, ScansSurviveReopeningWithPosesAndPoints) {
+  Pose est, placed;
+  est.x = 1;
+  est.yaw = 0.5;
+  placed.x = 1.2;
+  placed.yaw = 0.45;
+  {
+    SessionStore s(dir_);
+    EXPECT_EQ(s.add_scan("robot1", est, placed, 42, cloud_of(10, 0)).id, 1);
+    EXPECT_EQ(s.add_scan("robot2", est, placed, 43, cloud_of(5, 100)).id, 2);
+    s.append_event("approval", R"({"candidate":1,"by":"operator"})");
+  }
+  SessionStore s(dir_);
+  const auto scans = s.scans();
+  ASSERT_EQ(scans.size(), 2u);
+  EXPECT_EQ(scans[1].robot, "robot2");
+  EXPECT_EQ(scans[1].points, 5u);
+  EXPECT_DOUBLE_EQ(scans[0].placed.x, 1.2);
+  EXPECT_DOUBLE_EQ(scans[0].estimated.yaw, 0.5);
+  EXPECT_EQ(scans[0].stamp_ns, 42);
+  const PointCloud back = s.load_points(scans[1]);
+  ASSERT_EQ(back.size(), 5u);
+  EXPECT_EQ(back.points[4], Eigen::Vector3f(104, 8, 0.5f));
+  EXPECT_EQ(back.colors[0], (Rgb{10, 20, 30}));
+  EXPECT_EQ(s.scan(2)->file, "scans/scan_000002.ply");
+  EXPECT_FALSE(s.scan(3));
+  EXPECT_EQ(s.add_scan("robot1", est, placed, 44, cloud_of(1, 0)).id, 3);
+}
+
+TEST_F(SessionDir, EventsReadBackNewestLimitOldestFirst) {
+  {
+    SessionStore s(dir_);
+    EXPECT_TRUE(s.events(10).empty());
+    for (int k = 1; k <= 5; ++k) {
+      s.append_event(k % 2 ? "approve" : "reject", "{\"candidate\":" + std::to_string(k) + "}");
+    }
+  }
+  SessionStore s(dir_);  // what was recorded survives reopening
+  const auto all = s.events(100);
+  ASSERT_EQ(all.size(), 5u);
+  EXPECT_EQ(all.front().kind, "approve");
+  EXPECT_EQ(all.front().json, R"({"candidate":1})");
+  EXPECT_EQ(all.back().json, R"({"candidate":5})");
+  for (std::size_t k = 1; k < all.size(); ++k) EXPECT_LT(all[k - 1].id, all[k].id);
+  EXPECT_EQ(all.front().at.size(), std::string("2026-01-01T00:00:00.000Z").size());
+  const auto last = s.events(2);
+  ASSERT_EQ(last.size(), 2u);
+  EXPECT_EQ(last[0].json, R"({"candidate":4})");
+  EXPECT_EQ(last[1].kind, "approve");
+}
+
+TEST_F(SessionDir, PartialWritesFromACrashAreDiscardedOnOpen) {
+  {
+    SessionStore first(dir_);
+    first.add_scan("robot1", {}, {}, 1, cloud_of(3, 0));
+  }
+  // What a process killed mid-scan leaves: a half-written temporary and a PLY whose row never
+  // committed.
+  std::ofstream(dir_ / "scans" / "scan_000002.ply.part") << "ply\nformat binary";
+  std::ofstream(dir_ / "scans" / "scan_000002.ply") << "ply\n";
+  SessionStore s(dir_);
+  EXPECT_EQ(s.scans().size(), 1u);
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "scans" / "scan_000002.ply"));
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "scans" / "scan_000002.ply.part"));
+  EXPECT_EQ(s.add_scan("robot1", {}, {}, 2, cloud_of(2, 0)).id, 2);
+}
+
+TEST_F(SessionDir, UnusableDirectoryIsReportedWithItsPath) {
+  std::ofstream(dir_.string()) << "a file, not a directory";
+  try {
+    SessionStore s(dir_);
+    FAIL() << "a file in place of the session directory must be refused";
+  } catch (const SessionStoreError& e) {
+    EXPECT_NE(std::string(e.what()).find(dir_.string()), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(dir_);
+}
+
+TEST_F(SessionDir, AnnotationsSurviveReopeningAndDeletionsAreKeptOut) {
+  std::int64_t victim_ns = 0;
+  {
+    SessionStore s(dir_);
+    const Annotation v =
+        s.add_annotation("victim", 1.5, -2.25, 0.5, "two adults, responsive", "operator Ann");
+    EXPECT_EQ(v.id, 1);
+    EXPECT_GT(v.created_ns, 0);
+    EXPECT_EQ(v.created_at.size(), 24u) << v.created_at;  // 2026-11-02T10:11:12.345Z
+    victim_ns = v.created_ns;
+    EXPECT_EQ(s.add_annotation("hazard", 3, 4, 0, "", "operator").id, 2);
+    EXPECT_EQ(s.add_annotation("note", 5, 6, 1, "gas smell", "operator").id, 3);
+    EXPECT_TRUE(s.delete_annotation(2, "operator Bob"));
+    EXPECT_FALSE(s.delete_annotation(2, "operator Bob")) << "already deleted";
+    EXPECT_FALSE(s.delete_annotation(99, "operator")) << "never existed";
+  }
+  SessionStore s(dir_);
+  const auto list = s.annotations();
+  ASSERT_EQ(list.size(), 2u);
+  EXPECT_EQ(list[0].id, 1);
+  EXPECT_EQ(list[0].kind, "victim");
+  EXPECT_DOUBLE_EQ(list[0].y, -2.25);
+  EXPECT_EQ(list[0].text, "two adults, responsive");
+  EXPECT_EQ(list[0].author, "operator Ann");
+  EXPECT_EQ(list[0].created_ns, victim_ns);
+  EXPECT_EQ(list[1].id, 3);
+  EXPECT_EQ(s.add_annotation("blocked", 0, 0, 0, "", "operator").id, 4) << "ids are not reused";
+}
+
+TEST_F(SessionDir, InvalidAnnotationsAreRefusedAndNothingIsStored) {
+  SessionStore s(dir_);
+  EXPECT_THROW(s.add_annotation("rubble", 0, 0, 0, "", "operator"), SessionStoreError);
+  EXPECT_THROW(s.add_annotation("victim", std::nan(""), 0, 0, "", "operator"), SessionStoreError);
+  EXPECT_THROW(s.add_annotation("victim", 0, INFINITY, 0, "", "operator"), SessionStoreError);
+  EXPECT_THROW(
+      s.add_annotation("note", 0, 0, 0, std::string(kMaxAnnotationTextBytes + 1, 'a'), "operator"),
+      SessionStoreError);
+  EXPECT_TRUE(s.annotations().empty());
+  // Text is stored as given, quotes and all: statements bind values, never splice them.
+  const std::string tricky = "'); DROP TABLE annotations; --";
+  EXPECT_EQ(s.add_annotation("note", 0, 0, 0, tricky, "operator").text, tricky);
+  EXPECT_EQ(s.annotations().at(0).text, tricky);
+}
+
+}  // namespace
+}  // namespace scanplan
