@@ -5,6 +5,7 @@
 #include <ctime>
 
 #include "candidate_table.hpp"
+#include "common/iso_time.hpp"
 #include "event_text.hpp"
 #include "text_format.hpp"
 
@@ -25,12 +26,7 @@ std::string clock_of_event(const json& e) {
 
 // The server's "at" format, for the client's own connection events.
 std::string utc_now() {
-  const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
+  return iso8601_utc_now();
 }
 
 }  // namespace

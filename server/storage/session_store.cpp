@@ -12,26 +12,14 @@
 #include <ctime>
 #include <set>
 
+#include "common/iso_time.hpp"
 #include "scanplan/io/ply_io.hpp"
 
 namespace scanplan {
 namespace {
 
-std::string utc_iso(std::chrono::system_clock::time_point now) {
-  const std::time_t t = std::chrono::system_clock::to_time_t(now);
-  const auto ms =
-      std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[40];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &tm);
-  char out[48];
-  std::snprintf(out, sizeof out, "%s.%03dZ", buf, static_cast<int>(ms));
-  return out;
-}
-
 std::string utc_now() {
-  return utc_iso(std::chrono::system_clock::now());
+  return iso8601_utc_now(TimePrecision::kMilliseconds);
 }
 
 // Writes `bytes` to `path` so that after return the file is whole on disk under its name:
@@ -292,7 +280,7 @@ Annotation SessionStore::add_annotation(const std::string& kind, double x, doubl
   a.author = author;
   a.created_ns =
       std::chrono::duration_cast<std::chrono::nanoseconds>(now.time_since_epoch()).count();
-  a.created_at = utc_iso(now);
+  a.created_at = iso8601_utc(now, TimePrecision::kMilliseconds);
   std::lock_guard lock(mutex_);
   // One statement in autocommit mode: with WAL and synchronous=FULL it is durable on return.
   Statement s(db_,

@@ -76,6 +76,8 @@ export class AnnotationsPanel {
   /** An `annotation` event. */
   onEvent(e) {
     if (!valid(e)) return;
+    // type and at are destructured only to leave them out of the stored mark.
+    // eslint-disable-next-line no-unused-vars
     const { type, at, ...a } = e;
     this.items.set(a.id, a);
     if (this.state !== 'available') this.state = 'available';

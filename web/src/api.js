@@ -107,7 +107,7 @@ export async function apiFetch(path, { timeoutMs = 15000, method = 'GET', header
   let res;
   try {
     res = await fetch(path, { method, headers: h, body, signal: ctrl.signal, cache: 'no-store' });
-  } catch (e) {
+  } catch {
     clearTimeout(timer);
     const why = ctrl.signal.aborted ? `timed out after ${Math.round(timeoutMs / 1000)} s` : 'server unreachable';
     throw new ApiError(`${path}: ${why}`, { network: true });

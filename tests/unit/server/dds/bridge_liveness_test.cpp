@@ -1,6 +1,6 @@
 // The server's bookkeeping of which robots' bridges are alive, fed the way DdsLink feeds it from
 // Cyclone's liveliness changes and RobotStatus samples (handles are made up: no DDS here).
-#include "src/bridge_liveness.hpp"
+#include "dds/bridge_liveness.hpp"
 
 #include <gtest/gtest.h>
 

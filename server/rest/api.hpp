@@ -3,21 +3,37 @@
 #include <chrono>
 #include <string>
 
-#include "annotations.hpp"
-#include "auth.hpp"
-#include "dds_link.hpp"
+#include "app/annotations.hpp"
+#include "app/live_map.hpp"
+#include "app/mission.hpp"
+#include "app/plan_book.hpp"
+#include "app/robot_board.hpp"
+#include "app/scan_intake.hpp"
+#include "dds/dds_link.hpp"
 #include "http/router.hpp"
-#include "mission.hpp"
-#include "scan_store.hpp"
+#include "http/websocket_hub.hpp"
+#include "rest/auth.hpp"
 
 namespace scanplan::server {
 
-// The REST API (DESIGN.md "REST"): handlers translate HTTP to calls on the store and the DDS
-// link and back; they hold no state of their own beyond the session's start time.
+// What the handlers work on: the application's parts, owned by main.
+struct ApiParts {
+  LiveMap& map;
+  PlanBook& plans;
+  const RobotBoard& robots;
+  ScanIntake& intake;
+  DdsLink& dds;
+  Mission& mission;
+  Annotations& annotations;
+  http::WebSocketHub& hub;
+};
+
+// The REST API (DESIGN.md "REST") and the events WebSocket: handlers translate HTTP to calls on
+// the application and back, and are the only code that knows HTTP status codes. They hold no
+// state of their own beyond the session's start time.
 class Api {
  public:
-  Api(ScanStore& store, ScanIntake& intake, DdsLink& dds, Mission& mission,
-      Annotations& annotations, const Auth& auth, std::string session_dir);
+  Api(ApiParts parts, const Auth& auth, std::string session_dir);
   void install(http::Router& router);
 
  private:
@@ -42,12 +58,11 @@ class Api {
   http::Response list_annotations() const;
   http::Response post_annotation(const http::Request& request);
   http::Response delete_annotation(const http::Request& request, const std::string& id);
+  // GET /api/v1/events: the WebSocket upgrade. Browsers cannot set headers on a WebSocket: the
+  // token may come as ?token=.
+  http::Response events(const http::Request& request) const;
 
-  ScanStore& store_;
-  ScanIntake& intake_;
-  DdsLink& dds_;
-  Mission& mission_;
-  Annotations& annotations_;
+  ApiParts app_;
   const Auth& auth_;
   std::string session_dir_;
   std::chrono::system_clock::time_point started_;

@@ -1,4 +1,6 @@
-#include "scan_intake.hpp"
+#include "app/scan_intake.hpp"
+
+#include "app/domain_json.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -7,7 +9,7 @@
 
 namespace scanplan::server {
 
-ScanIntake::ScanIntake(SessionStore& session, ScanStore& live, const Events& events)
+ScanIntake::ScanIntake(SessionStore& session, LiveMap& live, const Events& events)
     : session_(session), live_(live), events_(events) {}
 
 ScanIntake::~ScanIntake() {
@@ -68,20 +70,7 @@ StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
   const MapMatch& m = *matched;
   const Pose& e = scan.estimated;
   const Pose& p = m.placed;
-  events_.publish("match_done",
-                  {{"scan", scan.id},
-                   {"method", m.result.method},
-                   {"converged", m.result.converged},
-                   {"applied", m.applied},
-                   {"score", m.result.score},
-                   {"rmse", m.result.rmse},
-                   {"time_ms", m.result.time_ms},
-                   {"message", m.result.message},
-                   {"correction",
-                    {{"x", p.x - e.x},
-                     {"y", p.y - e.y},
-                     {"z", p.z - e.z},
-                     {"yaw_deg", rad2deg(std::remainder(p.yaw - e.yaw, 2 * M_PI))}}}});
+  events_.publish("match_done", match_done_json(scan.id, e, m));
   if (!m.applied) {
     spdlog::warn("scan {} stays at its reported pose: {}", scan.id, m.result.message);
     return scan;
@@ -95,26 +84,15 @@ StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
 }
 
 void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud) {
-  live_.add(scan, cloud);
+  std::vector<PlanRecord> plans = live_.add(scan, cloud);
   if (const auto chunk = live_.encoded_chunk(scan.id)) events_.map_chunk(scan.id, *chunk);
   const MapAreas a = live_.areas();
-  events_.publish("map_updated", {{"scan", scan.id},
-                                  {"points", scan.points},
-                                  {"completed_m2", a.completed_m2},
-                                  {"low_resolution_m2", a.low_resolution_m2},
-                                  {"unscanned_m2", a.unscanned_m2},
-                                  {"movable_m2", a.movable_m2}});
+  events_.publish("map_updated", map_updated_json(scan, a));
   // One plan per robot that is not driving; the scanning robot's first.
-  std::vector<PlanRecord> plans = live_.plans();
   std::stable_partition(plans.begin(), plans.end(),
                         [&](const PlanRecord& p) { return p.robot == scan.robot; });
   for (const PlanRecord& plan : plans) {
-    if (plan.based_on_scan != scan.id) continue;
-    events_.publish("plan_done", {{"plan", plan.id},
-                                  {"robot", plan.robot},
-                                  {"based_on_scan", plan.based_on_scan},
-                                  {"candidates", plan.candidates.size()},
-                                  {"plan_ms", plan.plan_ms}});
+    events_.publish("plan_done", plan_done_json(plan));
   }
 }
 

@@ -1,4 +1,4 @@
-#include "bridge_liveness.hpp"
+#include "dds/bridge_liveness.hpp"
 
 #include "scanplan/msgs/dds_participant.hpp"
 

@@ -1,4 +1,4 @@
-#include "dds_link.hpp"
+#include "dds/dds_link.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -6,6 +6,8 @@
 #include <ctime>
 #include <memory>
 
+#include "app/domain_json.hpp"
+#include "common/iso_time.hpp"
 #include "ros2_types.h"
 #include "scanplan.h"
 #include "scanplan/io/image_codec.hpp"
@@ -19,15 +21,6 @@
 namespace scanplan::server {
 namespace {
 
-// A scan whose other parts never come (a bridge that died between writes) must not pin memory
-// for the rest of the session.
-constexpr std::size_t kMaxPartial = 8;
-constexpr auto kImageWait = std::chrono::seconds(2);
-constexpr auto kPartialExpiry = std::chrono::seconds(60);
-// Scans discarded with their bridge, remembered so that a part still in flight (a link that
-// came back) cannot start the scan over; a handful covers every scan a robot can have open.
-constexpr std::size_t kMaxDiscarded = 32;
-
 std::string str(const char* s) {
   return s ? s : "";
 }
@@ -36,15 +29,6 @@ std::int64_t now_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
              std::chrono::system_clock::now().time_since_epoch())
       .count();
-}
-
-std::string iso_now() {
-  const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char at[32];
-  std::strftime(at, sizeof at, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return at;
 }
 
 struct ListenerDeleter {
@@ -64,9 +48,9 @@ dds_instance_handle_t participant_of_publication(dds_entity_t reader,
 
 }  // namespace
 
-DdsLink::DdsLink(std::uint32_t domain_id, ScanStore& store, ScanIntake& intake,
+DdsLink::DdsLink(std::uint32_t domain_id, RobotBoard& robots, ScanIntake& intake,
                  const Events& events)
-    : store_(store), intake_(intake), events_(events), participant_(domain_id) {
+    : robots_(robots), intake_(intake), events_(events), participant_(domain_id) {
   using dds::QosKind;
   auto& p = participant_;
   // Every reader of bridge data requests the bridge lease (QosKind kScanData / kStatus) and
@@ -126,7 +110,7 @@ void DdsLink::stop() {
 void DdsLink::require_connected(const std::string& robot_id) const {
   if (robot_id.empty() || robot_connected(robot_id)) return;
   std::string since;
-  const auto states = store_.robot_states();
+  const auto states = robots_.states();
   if (const auto it = states.find(robot_id); it != states.end()) {
     since = " at " + it->second.connection.lost_at + " (" + it->second.connection.reason + ")";
   }
@@ -162,7 +146,7 @@ std::uint32_t DdsLink::request_scan(const std::string& robot_id) {
     robots = liveness_.connected_robots();
   }
   std::lock_guard lock(awaited_mutex_);
-  for (const std::string& r : robots) awaited_[r] = {id, "requested", 0.0f};
+  for (const std::string& r : robots) awaited_[r] = {id, ScanState::kRequested, 0.0f};
   return id;
 }
 
@@ -368,51 +352,35 @@ void DdsLink::robot_changed(const BridgeLiveness::Change& change) {
     return;
   }
   spdlog::info("the bridge of robot '{}' is back", change.robot);
-  store_.set_robot_connection(change.robot, RobotConnection{});
+  robots_.set_connection(change.robot, RobotConnection{});
   if (on_robot_back) on_robot_back(change.robot);
 }
 
 void DdsLink::lose_robot(const std::string& robot, const std::string& reason) {
-  RobotLoss loss{robot, reason, iso_now(), std::nullopt};
+  RobotLoss loss{robot, reason, iso8601_utc_now(), std::nullopt};
   // Whatever of its scans has arrived can never be completed by this bridge.
-  std::size_t parts = 0;
-  for (auto it = partial_.begin(); it != partial_.end();) {
-    if (it->first.first != robot) {
-      ++it;
-      continue;
-    }
-    const PartialScan& s = it->second;
-    parts += s.points.has_value() + s.pose.has_value() + s.jpeg.has_value() + s.camera.has_value();
-    discarded_.push_back(it->first);
-    if (discarded_.size() > kMaxDiscarded) discarded_.pop_front();
-    it = partial_.erase(it);
-  }
+  const std::size_t parts = assembly_.discard(robot);
   {
     std::lock_guard lock(awaited_mutex_);
     const auto it = awaited_.find(robot);
-    // "done" with nothing left in partial_ means the scan is in (or was never going to come).
-    if (it != awaited_.end() && (it->second.state != "done" || parts > 0)) {
+    // Done with nothing left in the assembly means the scan is in (or was never going to come).
+    if (it != awaited_.end() && (it->second.state != ScanState::kDone || parts > 0)) {
       loss.scan = ScanLoss{it->second.command_id, it->second.fraction, parts};
     } else if (parts > 0) {
       loss.scan = ScanLoss{0, 1.0f, parts};
     }
     if (it != awaited_.end()) awaited_.erase(it);
   }
-  store_.set_robot_connection(robot, RobotConnection{false, loss.lost_at, reason});
+  robots_.set_connection(robot, RobotConnection{false, loss.lost_at, reason});
   if (loss.scan) {
-    store_.set_scan_state(robot,
-                          {loss.scan->command_id, "failed", loss.scan->fraction, kScanLostReason});
+    robots_.set_scan_state(
+        robot, {loss.scan->command_id, ScanState::kFailed, loss.scan->fraction, kScanLostReason});
     spdlog::warn("robot '{}' lost: {}; scan command {} discarded ({} parts had arrived)", robot,
                  reason, loss.scan->command_id, loss.scan->parts_discarded);
   } else {
     spdlog::warn("robot '{}' lost: {}", robot, reason);
   }
   if (on_robot_lost) on_robot_lost(loss);
-}
-
-DdsLink::PartialScan* DdsLink::part(const Key& key) {
-  if (std::find(discarded_.begin(), discarded_.end(), key) != discarded_.end()) return nullptr;
-  return &partial_[key];
 }
 
 void DdsLink::loop() {
@@ -436,29 +404,37 @@ void DdsLink::loop() {
 }
 
 void DdsLink::take_samples() {
+  take_progress();
+  take_status();
+  take_scan_parts();
+}
+
+void DdsLink::take_progress() {
   dds::take_all<scanplan_ScanProgress>(
       progress_reader_, [&](const scanplan_ScanProgress& p, const dds_sample_info_t& info) {
         if (from_lost_bridge(info)) return;
+        const std::string robot = str(p.robot_id);
+        // A progress state this server does not know counts as the robot saying it failed.
+        const ScanState state = parse_scan_state(str(p.state)).value_or(ScanState::kFailed);
         {
           std::lock_guard lock(awaited_mutex_);
-          const std::string state = str(p.state);
-          if (state == "scanning" || state == "done") {
-            awaited_[str(p.robot_id)] = {p.command_id, state, p.fraction};
+          if (state == ScanState::kScanning || state == ScanState::kDone) {
+            awaited_[robot] = {p.command_id, state, p.fraction};
           } else {
-            awaited_.erase(str(p.robot_id));  // failed: the robot said so itself
+            awaited_.erase(robot);  // failed: the robot said so itself
           }
         }
-        store_.set_scan_state(str(p.robot_id),
-                              {p.command_id, str(p.state), p.fraction, str(p.message)});
-        events_.publish("scan_progress", {{"robot", str(p.robot_id)},
-                                          {"command_id", p.command_id},
-                                          {"state", str(p.state)},
-                                          {"fraction", p.fraction},
-                                          {"message", str(p.message)}});
+        const RobotScanState scan{p.command_id, state, p.fraction, str(p.message)};
+        robots_.set_scan_state(robot, scan);
+        events_.publish("scan_progress", scan_progress_json(robot, scan));
       });
+}
+
+void DdsLink::take_status() {
   dds::take_all<scanplan_RobotStatus>(
       status_reader_, [&](const scanplan_RobotStatus& s, const dds_sample_info_t& info) {
         if (from_lost_bridge(info)) return;
+        const std::string robot = str(s.robot_id);
         // The status names the robot the writer's participant (the bridge) speaks for.
         bool known = false;
         {
@@ -470,29 +446,24 @@ void DdsLink::take_samples() {
         std::optional<BridgeLiveness::Change> change;
         {
           std::lock_guard lock(liveness_mutex_);
-          change = liveness_.announced(info.publication_handle, participant, str(s.robot_id));
+          change = liveness_.announced(info.publication_handle, participant, robot);
         }
         if (change) robot_changed(*change);
-        // The bridge's last word: published (as a status) before the robot is reported lost.
-        const bool goodbye = str(s.state) == "offline";
         Pose pose;
         pose.x = s.x;
         pose.y = s.y;
         pose.z = s.z;
         pose.yaw = deg2rad(s.yaw_deg);
-        const RobotStatus status{s.command_id, str(s.state), str(s.message), pose};
-        store_.set_robot_status(str(s.robot_id), status);
+        const RobotStatus status{s.command_id, parse_robot_activity(str(s.state)), str(s.message),
+                                 pose};
+        robots_.set_status(robot, status);
         // The once-a-second idle heartbeat is not news.
-        if (status.state != "idle" || status.command_id != 0) {
-          events_.publish("robot_status",
-                          {{"robot", str(s.robot_id)},
-                           {"command_id", s.command_id},
-                           {"state", status.state},
-                           {"message", status.message},
-                           {"pose", {{"x", s.x}, {"y", s.y}, {"z", s.z}, {"yaw_deg", s.yaw_deg}}}});
+        if (status.state != RobotActivity::kIdle || status.command_id != 0) {
+          events_.publish("robot_status", robot_status_json(robot, status));
         }
-        if (on_status) on_status(str(s.robot_id), status);
-        if (goodbye) {
+        if (on_status) on_status(robot, status);
+        // The bridge's last word: published (as a status) before the robot is reported lost.
+        if (status.state == RobotActivity::kOffline) {
           {
             std::lock_guard lock(liveness_mutex_);
             change = liveness_.said_goodbye(info.publication_handle);
@@ -500,16 +471,19 @@ void DdsLink::take_samples() {
           if (change) robot_changed(*change);
         }
       });
+}
+
+void DdsLink::take_scan_parts() {
   const auto key_of = [](const std_msgs_msg_dds__Header_& h) {
     return Key{dds::robot_id_of(h.frame_id), dds::stamp_ns(h.stamp)};
   };
+  const auto now = ScanAssembly::Clock::now();
   dds::take_all<sensor_msgs_msg_dds__CameraInfo_>(
       camera_info_reader_,
       [&](const sensor_msgs_msg_dds__CameraInfo_& m, const dds_sample_info_t& info) {
-        PartialScan* s = from_lost_bridge(info) ? nullptr : part(key_of(m.header));
-        if (!s) return;
+        if (from_lost_bridge(info)) return;
         try {
-          s->camera = dds::from_camera_info(m);
+          assembly_.add_camera(key_of(m.header), dds::from_camera_info(m), now);
         } catch (const dds::CameraInfoError& e) {
           spdlog::warn("ignoring camera info from '{}': {}", key_of(m.header).first, e.what());
         }
@@ -517,23 +491,23 @@ void DdsLink::take_samples() {
   dds::take_all<sensor_msgs_msg_dds__CompressedImage_>(
       image_reader_,
       [&](const sensor_msgs_msg_dds__CompressedImage_& m, const dds_sample_info_t& info) {
-        PartialScan* s = from_lost_bridge(info) ? nullptr : part(key_of(m.header));
-        if (s) s->jpeg.emplace(m.data._buffer, m.data._buffer + m.data._length);
+        if (from_lost_bridge(info)) return;
+        assembly_.add_image(key_of(m.header), {m.data._buffer, m.data._buffer + m.data._length},
+                            now);
       });
   dds::take_all<geometry_msgs_msg_dds__PoseStamped_>(
       pose_reader_,
       [&](const geometry_msgs_msg_dds__PoseStamped_& m, const dds_sample_info_t& info) {
-        PartialScan* s = from_lost_bridge(info) ? nullptr : part(key_of(m.header));
-        if (s) s->pose = dds::from_pose_stamped(m);
+        if (!from_lost_bridge(info))
+          assembly_.add_pose(key_of(m.header), dds::from_pose_stamped(m), now);
       });
   dds::take_all<sensor_msgs_msg_dds__PointCloud2_>(
       points_reader_,
       [&](const sensor_msgs_msg_dds__PointCloud2_& m, const dds_sample_info_t& info) {
+        if (from_lost_bridge(info)) return;
         const Key key = key_of(m.header);
-        PartialScan* s = from_lost_bridge(info) ? nullptr : part(key);
-        if (!s) return;
         try {
-          s->points = dds::unpack_pointcloud2(m);
+          assembly_.add_points(key, dds::unpack_pointcloud2(m), now);
         } catch (const dds::PointCloud2Error& e) {
           spdlog::warn("discarding a scan from '{}': {}", key.first, e.what());
         }
@@ -541,27 +515,17 @@ void DdsLink::take_samples() {
 }
 
 void DdsLink::complete_scans() {
-  const auto now = std::chrono::steady_clock::now();
-  for (auto it = partial_.begin(); it != partial_.end();) {
-    PartialScan& s = it->second;
-    const bool has_image = s.jpeg && s.camera;
-    if (s.points && s.pose && (has_image || now - s.first_seen > kImageWait)) {
-      store_scan(it->first, s);
-      it = partial_.erase(it);
-    } else if (now - s.first_seen > kPartialExpiry) {
-      spdlog::warn("dropping an incomplete scan from '{}' (points {}, pose {})", it->first.first,
-                   s.points ? "in" : "missing", s.pose ? "in" : "missing");
-      it = partial_.erase(it);
-    } else {
-      ++it;
-    }
+  ScanAssembly::Taken taken = assembly_.take(ScanAssembly::Clock::now());
+  for (const ScanAssembly::Dropped& d : taken.dropped) {
+    spdlog::warn("dropping an incomplete scan from '{}' (points {}, pose {})", d.key.first,
+                 d.had_points ? "in" : "missing", d.had_pose ? "in" : "missing");
   }
-  while (partial_.size() > kMaxPartial) partial_.erase(partial_.begin());
+  for (AssembledScan& scan : taken.complete) store_scan(scan);
 }
 
-void DdsLink::store_scan(const Key& key, PartialScan& s) {
-  const std::string& robot = key.first;
-  PointCloud& cloud = *s.points;
+void DdsLink::store_scan(AssembledScan& s) {
+  const std::string& robot = s.robot;
+  PointCloud& cloud = s.points;
   if (s.jpeg && s.camera) {
     try {
       const ColorizeStats stats = colorize(cloud, decode_image(*s.jpeg), *s.camera);
@@ -578,11 +542,11 @@ void DdsLink::store_scan(const Key& key, PartialScan& s) {
     // command, sent while this scan's parts were still being gathered.)
     std::lock_guard lock(awaited_mutex_);
     if (const auto it = awaited_.find(robot);
-        it != awaited_.end() && it->second.state != "requested")
+        it != awaited_.end() && it->second.state != ScanState::kRequested)
       awaited_.erase(it);
   }
   try {
-    const StoredScan r = intake_.submit(robot, *s.pose, key.second, std::move(cloud));
+    const StoredScan r = intake_.submit(robot, s.pose, s.stamp_ns, std::move(cloud));
     spdlog::info("scan {} from '{}' stored: {} points", r.id, robot, r.points);
   } catch (const std::exception& e) {
     spdlog::error("could not store a scan from '{}': {}", robot, e.what());

@@ -1,4 +1,4 @@
-#include "scan_store.hpp"
+#include "app/live_map.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,19 +13,13 @@
 
 namespace scanplan::server {
 
-double approach_yaw_deg(const Candidate& c) {
-  const auto& path = c.path;
-  if (path.size() < 2) return 0;
-  const Eigen::Vector2d d = path.back() - path[path.size() - 2];
-  return rad2deg(std::atan2(d.y(), d.x()));
-}
-
-ScanStore::ScanStore(MissionConfig config)
+LiveMap::LiveMap(PlanBook& plans, MissionConfig config)
     : mission_(std::move(config)),
+      plans_(plans),
       claim_separation_m_(mission_.planner().claim_separation_m),
       encoder_([this] { encode_loop(); }) {}
 
-ScanStore::~ScanStore() {
+LiveMap::~LiveMap() {
   {
     std::lock_guard lock(mutex_);
     stopping_ = true;
@@ -34,7 +28,7 @@ ScanStore::~ScanStore() {
   encoder_.join();
 }
 
-void ScanStore::encode_loop() {
+void LiveMap::encode_loop() {
   std::unique_lock lock(mutex_);
   for (;;) {
     encode_wanted_.wait(lock, [&] {
@@ -66,17 +60,17 @@ void ScanStore::encode_loop() {
   }
 }
 
-const std::vector<std::string>& ScanStore::layer_names() {
+const std::vector<std::string>& LiveMap::layer_names() {
   static const std::vector<std::string> kNames = {"regions", "elevation", "movable"};
   return kNames;
 }
 
-std::optional<MapMatch> ScanStore::place(const PointCloud& scan, const Pose& reported) const {
+std::optional<MapMatch> LiveMap::place(const PointCloud& scan, const Pose& reported) const {
   std::lock_guard encode_lock(encode_mutex_);
   return mission_.place(scan, reported);
 }
 
-void ScanStore::add(const StoredScan& scan, const PointCloud& cloud) {
+std::vector<PlanRecord> LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
   const Pose& pose = scan.placed;
   // Writers take turns on encode_mutex_; readers only wait for the short commit below, and
   // they see the scan, its points, its chunk and the plan that includes it appear together.
@@ -106,74 +100,51 @@ void ScanStore::add(const StoredScan& scan, const PointCloud& cloud) {
   if (on_plan) {
     for (const PlanRecord& plan : plans) on_plan(plan);
   }
+  return plans;
 }
 
 namespace {
 
-// The candidate the plan's robot is driving to (an approved move under way), if any.
-const CandidateRecord* active_goal(const PlanRecord& plan) {
-  for (const CandidateRecord& c : plan.candidates) {
-    if (c.state == "moving") return &c;
-  }
-  return nullptr;
+// The layers' pixels in the map, as top_view_pixel places them.
+LayerGeometry geometry_of(const RegionMap& regions) {
+  const auto& g = regions.cells;
+  const int s = std::max(1, TopViewStyle{}.px_per_cell);
+  LayerGeometry geometry;
+  geometry.min_x = g.origin.x * g.cell_m;
+  geometry.min_y = g.origin.y * g.cell_m;
+  geometry.max_x = (g.origin.x + g.cols) * g.cell_m;
+  geometry.max_y = (g.origin.y + g.rows) * g.cell_m;
+  geometry.px_per_m = s / g.cell_m;
+  geometry.width = g.cols * s;
+  geometry.height = g.rows * s;
+  return geometry;
 }
 
 }  // namespace
 
-std::vector<Eigen::Vector3d> ScanStore::claims_except(const std::string& robot) const {
-  std::vector<Eigen::Vector3d> claims;
-  for (const auto& [id, plan] : plans_) {
-    if (id == robot) continue;
-    const CandidateRecord* goal = active_goal(plan);
-    for (const CandidateRecord& c : plan.candidates) {
-      if (!goal && c.state == "proposed" && c.rank == 1) goal = &c;
-    }
-    if (goal) claims.push_back(goal->candidate.position);
-  }
-  return claims;
-}
-
-std::vector<PlanRecord> ScanStore::refresh_derived(const std::function<void()>& commit) {
-  const MappingPipeline& mapping = mission_.mapping();
-  if (!mission_.has_map()) {
-    std::lock_guard lock(mutex_);
-    if (commit) commit();
-    return {};
-  }
-  const RegionMap& regions = *mapping.regions();
-  const MovableRegion& movable = *mapping.movable();
-  const std::vector<Eigen::Vector2d> points = mapping.scan_points();
-
+std::vector<PlanRecord> LiveMap::make_plans() const {
   // Several robots share the map: they are decided one after another (plan_fleet), each
   // counting what the robots before it will scan as taken (PlanInput::claimed), so no two are
   // sent to one spot. A robot driving to an approved goal keeps its plan, and its goal is
   // claimed first.
   std::vector<Eigen::Vector3d> claims;
-  std::set<std::string> driving;
-  {
-    std::lock_guard lock(mutex_);
-    for (const auto& [robot, plan] : plans_) {
-      if (const CandidateRecord* goal = active_goal(plan)) {
-        claims.push_back(goal->candidate.position);
-        driving.insert(robot);
-      }
-    }
-  }
+  const std::map<std::string, Eigen::Vector3d> driving = plans_.driving_goals();
+  for (const auto& [robot, goal] : driving) claims.push_back(goal);
   std::vector<FleetRobot> robots;
   for (const auto& [robot, at] : scan_pose_of_) {
     if (!driving.count(robot)) robots.push_back({robot, {at.x, at.y, at.z}});
   }
-  std::vector<PlanRecord> records;
   const PlannerConfig& planner = mission_.planner();
+  std::vector<PlanRecord> records;
   for (FleetPlan& decided : mission_.plan(robots, std::move(claims))) {
     const Plan& plan = decided.plan;
     PlanRecord record;
-    record.id = next_plan_id_++;
+    record.id = plans_.new_plan_id();
     record.based_on_scan = last_scan_.first;
     record.robot = decided.robot;
     for (std::size_t k = 0; k < plan.ranked.size(); ++k) {
       CandidateRecord c;
-      c.id = next_candidate_id_++;
+      c.id = plans_.new_candidate_id();
       c.rank = static_cast<int>(k + 1);
       c.candidate = plan.ranked[k];
       record.candidates.push_back(std::move(c));
@@ -187,47 +158,44 @@ std::vector<PlanRecord> ScanStore::refresh_derived(const std::function<void()>& 
   // newest on the latched DDS topic.
   std::stable_partition(records.begin(), records.end(),
                         [&](const PlanRecord& r) { return r.robot != last_scan_.second; });
+  return records;
+}
 
+std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> LiveMap::render_layers()
+    const {
+  const MappingPipeline& mapping = mission_.mapping();
+  const RegionMap& regions = *mapping.regions();
+  const MovableRegion& movable = *mapping.movable();
   const auto png = [](const cv::Mat& img) {
     return std::make_shared<const std::vector<std::uint8_t>>(encode_png(img));
   };
   std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> layers;
   // The candidates are not drawn in: clients draw them over the layer (the page does, with
   // their states), and the layer stays the paper's Fig. 4/5.
-  layers["regions"] = png(render_regions(regions, &movable, points));
+  layers["regions"] = png(render_regions(regions, &movable, mapping.scan_points()));
   layers["elevation"] = png(render_elevation(mapping.map(), regions));
   layers["movable"] = png(render_movable(mapping.map(), movable, regions));
-  const MapAreas areas{regions.completed_m2(), regions.low_resolution_m2(), regions.unscanned_m2(),
-                       movable.area_m2()};
-  // The layers' pixels in the map, as top_view_pixel places them.
-  LayerGeometry geometry;
-  {
-    const auto& g = regions.cells;
-    const int s = std::max(1, TopViewStyle{}.px_per_cell);
-    geometry.min_x = g.origin.x * g.cell_m;
-    geometry.min_y = g.origin.y * g.cell_m;
-    geometry.max_x = (g.origin.x + g.cols) * g.cell_m;
-    geometry.max_y = (g.origin.y + g.rows) * g.cell_m;
-    geometry.px_per_m = s / g.cell_m;
-    geometry.width = g.cols * s;
-    geometry.height = g.rows * s;
-  }
+  return layers;
+}
 
+std::vector<PlanRecord> LiveMap::refresh_derived(const std::function<void()>& commit) {
+  if (!mission_.has_map()) {
+    std::lock_guard lock(mutex_);
+    if (commit) commit();
+    return {};
+  }
+  std::vector<PlanRecord> records = make_plans();
+  auto layers = render_layers();
+  const RegionMap& regions = *mission_.mapping().regions();
+  const MapAreas areas{regions.completed_m2(), regions.low_resolution_m2(), regions.unscanned_m2(),
+                       mission_.mapping().movable()->area_m2()};
   {
     // The scan, its map and everything derived from it appear to readers together.
     std::lock_guard lock(mutex_);
     if (commit) commit();
-    for (const PlanRecord& record : records) {
-      if (const auto old = plans_.find(record.robot); old != plans_.end()) {
-        for (auto& c : old->second.candidates) {
-          if (c.state == "proposed") c.state = "superseded";
-        }
-      }
-      plans_[record.robot] = record;
-    }
-    latest_robot_ = last_scan_.second;
+    plans_.replace(records, last_scan_.second);
     layers_ = std::move(layers);
-    layer_geometry_ = geometry;
+    layer_geometry_ = geometry_of(regions);
     areas_ = areas;
     // A commit means a scan joined (set_params re-segments without one).
     if (commit) areas_after_[last_scan_.first] = areas;
@@ -235,56 +203,21 @@ std::vector<PlanRecord> ScanStore::refresh_derived(const std::function<void()>& 
   return records;
 }
 
-std::optional<PlanRecord> ScanStore::plan(const std::string& robot) const {
-  std::lock_guard lock(mutex_);
-  const auto it = plans_.find(robot.empty() ? latest_robot_ : robot);
-  if (it == plans_.end()) return std::nullopt;
-  return it->second;
-}
+namespace {
 
-std::vector<PlanRecord> ScanStore::plans() const {
-  std::lock_guard lock(mutex_);
-  std::vector<PlanRecord> out;
-  for (const auto& [robot, plan] : plans_) out.push_back(plan);
-  return out;
-}
+// Where a robot sent to (x, y) would stand, and the drive there from `from`.
+struct GoalSite {
+  CellIndex cell;
+  float floor_z = 0;
+  TravelMap travel;
+};
 
-CandidateRecord* ScanStore::find_candidate(std::uint64_t id) {
-  for (auto& [robot, plan] : plans_) {
-    for (auto& c : plan.candidates) {
-      if (c.id == id) return &c;
-    }
-  }
-  return nullptr;
-}
-
-CandidateRecord ScanStore::add_goal(double x, double y, const std::string& robot_id) {
-  std::lock_guard encode_lock(encode_mutex_);
-  std::string robot;
-  std::vector<Eigen::Vector3d> claims;
-  {
-    std::lock_guard lock(mutex_);
-    if (plans_.empty()) throw GoalRefused("no_map", "there is no map yet: take a first scan");
-    robot = robot_id.empty() ? latest_robot_ : robot_id;
-    if (!plans_.count(robot)) {
-      throw GoalRefused("unknown_robot",
-                        "robot '" + robot + "' has no plan: it has not sent a scan yet");
-    }
-    claims = claims_except(robot);
-  }
-  const MappingPipeline& mapping = mission_.mapping();
-  if (!mission_.has_map() || mapping.scan_poses().empty()) {
-    throw GoalRefused("no_map", "there is no map yet: take a first scan");
-  }
-  const PlannerConfig& planner = mission_.planner();
+// Checks that a robot at `from`, which can reach `movable`, can be sent to (x, y); throws
+// GoalRefused naming why not.
+GoalSite goal_site(const MappingPipeline& mapping, const PlannerConfig& planner,
+                   const MovableRegion& movable, const Eigen::Vector3d& from, double x, double y) {
   const MlsMap& map = mapping.map();
   const TargetRegion& target = *mapping.target();
-  const Pose at = scan_pose_of_.at(robot);
-  const Eigen::Vector3d from(at.x, at.y, at.z);
-  // The region this robot can reach, flooded from where it stands (the pipeline's is the last
-  // scanning robot's, and two robots may stand in parts of the site apart from each other).
-  const MovableRegion movable =
-      robot == last_scan_.second ? *mapping.movable() : movable_region(map, from, planner.movable);
   char where[64];
   std::snprintf(where, sizeof where, "(%.1f, %.1f)", x, y);
   if (!target.contains(x, y)) {
@@ -305,7 +238,7 @@ CandidateRecord ScanStore::add_goal(double x, double y, const std::string& robot
                   planner.movable.max_step_m);
     throw GoalRefused("not_movable", where + std::string(why));
   }
-  const TravelMap travel =
+  TravelMap travel =
       travel_map(map, movable, from, planner.movable, planner.stay_in_target ? &target : nullptr);
   if (!travel.reachable(cell)) {
     throw GoalRefused("unreachable", std::string(where) +
@@ -314,38 +247,54 @@ CandidateRecord ScanStore::add_goal(double x, double y, const std::string& robot
   }
   const auto offset = movable.patch.offset(cell);
   const float floor_z = map.cell(cell)->patches[movable.patch.values[*offset]].mean_z;
-  const Eigen::Vector2d centre = map.center_of(cell);
+  return {cell, floor_z, std::move(travel)};
+}
+
+}  // namespace
+
+CandidateRecord LiveMap::add_goal(double x, double y, const std::string& robot_id) {
+  std::lock_guard encode_lock(encode_mutex_);
+  if (plans_.empty()) throw GoalRefused("no_map", "there is no map yet: take a first scan");
+  const std::string robot = robot_id.empty() ? plans_.latest_robot() : robot_id;
+  if (!plans_.plan(robot)) {
+    throw GoalRefused("unknown_robot",
+                      "robot '" + robot + "' has no plan: it has not sent a scan yet");
+  }
+  const std::vector<Eigen::Vector3d> claims = plans_.claims_except(robot);
+  const MappingPipeline& mapping = mission_.mapping();
+  if (!mission_.has_map() || mapping.scan_poses().empty()) {
+    throw GoalRefused("no_map", "there is no map yet: take a first scan");
+  }
+  const PlannerConfig& planner = mission_.planner();
+  const Pose at = scan_pose_of_.at(robot);
+  const Eigen::Vector3d from(at.x, at.y, at.z);
+  // The region this robot can reach, flooded from where it stands (the pipeline's is the last
+  // scanning robot's, and two robots may stand in parts of the site apart from each other).
+  const MovableRegion movable = robot == last_scan_.second
+                                    ? *mapping.movable()
+                                    : movable_region(mapping.map(), from, planner.movable);
+  const GoalSite site = goal_site(mapping, planner, movable, from, x, y);
+  const Eigen::Vector2d centre = mapping.map().center_of(site.cell);
   const std::vector<Eigen::Vector2d> points = mapping.scan_points();
   CandidateRecord record;
-  PlanInput input{map, target, points, from};
+  PlanInput input{mapping.map(), *mapping.target(), points, from};
   input.claimed = &claims;
-  evaluate(input, planner, {centre.x(), centre.y(), floor_z}, &record.candidate);
-  record.candidate.travel_m = travel.distance(cell);
-  record.candidate.path = travel.path_to(cell);
-  record.id = next_candidate_id_++;
+  evaluate(input, planner, {centre.x(), centre.y(), site.floor_z}, &record.candidate);
+  record.candidate.travel_m = site.travel.distance(site.cell);
+  record.candidate.path = site.travel.path_to(site.cell);
+  record.id = plans_.new_candidate_id();
   record.rank = 0;
   record.custom = true;
-  std::lock_guard lock(mutex_);
-  plans_.at(robot).candidates.push_back(record);
+  plans_.add_candidate(robot, record);
   return record;
 }
 
-bool ScanStore::set_candidate_state(std::uint64_t id, const std::string& state,
-                                    const std::string& note) {
-  std::lock_guard lock(mutex_);
-  CandidateRecord* c = find_candidate(id);
-  if (!c) return false;
-  c->state = state;
-  c->note = note;
-  return true;
-}
-
-MissionParams ScanStore::params() const {
+MissionParams LiveMap::params() const {
   std::lock_guard lock(encode_mutex_);
   return {mission_.planner(), mission_.mapping().target()};
 }
 
-void ScanStore::set_params(const MissionParams& params) {
+void LiveMap::set_params(const MissionParams& params) {
   std::lock_guard encode_lock(encode_mutex_);
   claim_separation_m_ = params.planner.claim_separation_m;
   mission_.set_planner(params.planner);
@@ -356,33 +305,33 @@ void ScanStore::set_params(const MissionParams& params) {
   }
 }
 
-std::vector<StoredScan> ScanStore::scans() const {
+std::vector<StoredScan> LiveMap::scans() const {
   std::lock_guard lock(mutex_);
   return scans_;
 }
 
-std::optional<StoredScan> ScanStore::last_scan() const {
+std::optional<StoredScan> LiveMap::last_scan() const {
   std::lock_guard lock(mutex_);
   if (scans_.empty()) return std::nullopt;
   return scans_.back();
 }
 
-std::size_t ScanStore::scan_count() const {
+std::size_t LiveMap::scan_count() const {
   std::lock_guard lock(mutex_);
   return scans_.size();
 }
 
-std::size_t ScanStore::point_count() const {
+std::size_t LiveMap::point_count() const {
   std::lock_guard lock(mutex_);
   return point_count_;
 }
 
-Bounds3 ScanStore::bounds() const {
+Bounds3 LiveMap::bounds() const {
   std::lock_guard lock(mutex_);
   return bounds_;
 }
 
-ScanStore::EncodedMap ScanStore::encoded_map(std::chrono::milliseconds wait) const {
+LiveMap::EncodedMap LiveMap::encoded_map(std::chrono::milliseconds wait) const {
   std::unique_lock lock(mutex_);
   if (scans_.empty()) return {};
   encoded_changed_.wait_for(lock, wait,
@@ -390,13 +339,13 @@ ScanStore::EncodedMap ScanStore::encoded_map(std::chrono::milliseconds wait) con
   return {encoded_, encoded_last_scan_};
 }
 
-std::shared_ptr<const std::string> ScanStore::encoded_chunk(std::int64_t id) const {
+std::shared_ptr<const std::string> LiveMap::encoded_chunk(std::int64_t id) const {
   std::lock_guard lock(mutex_);
   const auto it = chunks_.find(id);
   return it == chunks_.end() ? nullptr : it->second;
 }
 
-ScanStore::EncodedMap ScanStore::encoded_since(std::int64_t since_id) const {
+LiveMap::EncodedMap LiveMap::encoded_since(std::int64_t since_id) const {
   PointCloud tail;
   std::int64_t last = 0;
   bool whole = false;
@@ -424,7 +373,7 @@ ScanStore::EncodedMap ScanStore::encoded_since(std::int64_t since_id) const {
   return {std::make_shared<const std::string>(encode_draco(tail)), last};
 }
 
-ScanStore::EncodedMap ScanStore::encoded_range(std::int64_t since_id, std::int64_t until_id) const {
+LiveMap::EncodedMap LiveMap::encoded_range(std::int64_t since_id, std::int64_t until_id) const {
   PointCloud part;
   std::int64_t last = 0;
   {
@@ -446,55 +395,34 @@ ScanStore::EncodedMap ScanStore::encoded_range(std::int64_t since_id, std::int64
   return {std::make_shared<const std::string>(encode_draco(part)), last};
 }
 
-std::optional<MapAreas> ScanStore::areas_after(std::int64_t id) const {
+std::optional<MapAreas> LiveMap::areas_after(std::int64_t id) const {
   std::lock_guard lock(mutex_);
   const auto it = areas_after_.find(id);
   if (it == areas_after_.end()) return std::nullopt;
   return it->second;
 }
 
-LayerImage ScanStore::layer(const std::string& name) const {
+LayerImage LiveMap::layer(const std::string& name) const {
   std::lock_guard lock(mutex_);
   const auto it = layers_.find(name);
   if (it == layers_.end() || !layer_geometry_) return {};
   return {it->second, *layer_geometry_};
 }
 
-std::optional<LayerGeometry> ScanStore::layer_geometry() const {
+std::optional<LayerGeometry> LiveMap::layer_geometry() const {
   std::lock_guard lock(mutex_);
   return layer_geometry_;
 }
 
-std::shared_ptr<const std::vector<std::uint8_t>> ScanStore::layer_png(
-    const std::string& name) const {
+std::shared_ptr<const std::vector<std::uint8_t>> LiveMap::layer_png(const std::string& name) const {
   std::lock_guard lock(mutex_);
   const auto it = layers_.find(name);
   return it == layers_.end() ? nullptr : it->second;
 }
 
-MapAreas ScanStore::areas() const {
+MapAreas LiveMap::areas() const {
   std::lock_guard lock(mutex_);
   return areas_;
-}
-
-void ScanStore::set_scan_state(const std::string& robot_id, RobotScanState state) {
-  std::lock_guard lock(mutex_);
-  robots_[robot_id].scan = std::move(state);
-}
-
-void ScanStore::set_robot_status(const std::string& robot_id, RobotStatus status) {
-  std::lock_guard lock(mutex_);
-  robots_[robot_id].status = std::move(status);
-}
-
-void ScanStore::set_robot_connection(const std::string& robot_id, RobotConnection connection) {
-  std::lock_guard lock(mutex_);
-  robots_[robot_id].connection = std::move(connection);
-}
-
-std::map<std::string, RobotState> ScanStore::robot_states() const {
-  std::lock_guard lock(mutex_);
-  return robots_;
 }
 
 }  // namespace scanplan::server

@@ -6,20 +6,18 @@
 #include <string>
 #include <vector>
 
-#include "dds_link.hpp"
-#include "events.hpp"
+#include "app/events.hpp"
+#include "app/robot_link.hpp"
 #include "storage/session_store.hpp"
 
 namespace scanplan::server {
-
-nlohmann::json annotation_json(const Annotation& a);
 
 // The operator's marks on the map (victims, hazards, blocked ways, notes). Each is committed to
 // the session before it is acknowledged, then announced to the browsers (WebSocket event
 // "annotation") and to DDS (scanplan_Annotation, latched), in that order.
 class Annotations {
  public:
-  Annotations(SessionStore& session, DdsLink& dds, const Events& events);
+  Annotations(SessionStore& session, AnnotationPublisher& dds, const Events& events);
 
   // Publishes every stored annotation on DDS: a restarted server's late joiners still get them.
   void republish();
@@ -32,7 +30,7 @@ class Annotations {
 
  private:
   SessionStore& session_;
-  DdsLink& dds_;
+  AnnotationPublisher& dds_;
   const Events& events_;
   // Storing and announcing happen together, so a deletion can never be announced before the
   // annotation it withdraws.

@@ -1,4 +1,4 @@
-#include "auth.hpp"
+#include "rest/auth.hpp"
 
 #include <openssl/crypto.h>
 #include <openssl/rand.h>

@@ -1,15 +1,12 @@
-#include "annotations.hpp"
+#include "app/annotations.hpp"
 
 #include <spdlog/spdlog.h>
 
+#include "app/domain_json.hpp"
+
 namespace scanplan::server {
 
-nlohmann::json annotation_json(const Annotation& a) {
-  return {{"id", a.id}, {"kind", a.kind}, {"x", a.x},           {"y", a.y},
-          {"z", a.z},   {"text", a.text}, {"author", a.author}, {"created_at", a.created_at}};
-}
-
-Annotations::Annotations(SessionStore& session, DdsLink& dds, const Events& events)
+Annotations::Annotations(SessionStore& session, AnnotationPublisher& dds, const Events& events)
     : session_(session), dds_(dds), events_(events) {}
 
 void Annotations::republish() {

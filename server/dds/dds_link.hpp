@@ -13,34 +13,18 @@
 #include <utility>
 #include <vector>
 
-#include "bridge_liveness.hpp"
-#include "events.hpp"
-#include "scan_intake.hpp"
-#include "scan_store.hpp"
+#include "app/events.hpp"
+#include "app/plan_book.hpp"
+#include "app/robot_board.hpp"
+#include "app/robot_link.hpp"
+#include "app/scan_intake.hpp"
+#include "dds/bridge_liveness.hpp"
+#include "dds/scan_assembly.hpp"
 #include "scanplan/geometry/panorama_camera.hpp"
 #include "scanplan/geometry/point_cloud.hpp"
 #include "scanplan/msgs/dds_participant.hpp"
 
 namespace scanplan::server {
-
-class NoScannerError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-// What a bridge's loss cost: the scan it was taking (or whose parts were still arriving).
-struct ScanLoss {
-  std::uint32_t command_id = 0;  // 0 when only parts of an unrequested scan were in
-  float fraction = 0;            // how far the scanner had got
-  std::size_t parts_discarded = 0;
-};
-
-struct RobotLoss {
-  std::string robot;
-  std::string reason;   // why the server counts the bridge as gone
-  std::string lost_at;  // UTC, ISO 8601
-  std::optional<ScanLoss> scan;
-};
 
 // The server's side of DDS: receives scans, poses, panoramas, progress and status from bridges
 // on its own thread, colourises each scan from its panorama and hands it to the store; sends
@@ -48,9 +32,9 @@ struct RobotLoss {
 // annotations to anyone (ROS 2 nodes included) on latched topics (docs/dds.md); watches each
 // bridge's liveliness and, when one is lost, drops whatever of its scan had arrived so nothing
 // half-received reaches the map.
-class DdsLink {
+class DdsLink final : public RobotLink, public AnnotationPublisher {
  public:
-  DdsLink(std::uint32_t domain_id, ScanStore& store, ScanIntake& intake, const Events& events);
+  DdsLink(std::uint32_t domain_id, RobotBoard& robots, ScanIntake& intake, const Events& events);
   ~DdsLink();
   DdsLink(const DdsLink&) = delete;
   DdsLink& operator=(const DdsLink&) = delete;
@@ -60,10 +44,11 @@ class DdsLink {
 
   // Asks `robot_id` (empty: every robot) for one scan; returns the command id.
   // Throws NoScannerError when no bridge is listening for commands or that robot's is lost.
-  std::uint32_t request_scan(const std::string& robot_id);
+  std::uint32_t request_scan(const std::string& robot_id) override;
   // Sends `robot_id` to (x, y) facing yaw; returns the command id. Throws NoScannerError when no
   // bridge listens for move commands or that robot's is lost.
-  std::uint32_t request_move(const std::string& robot_id, double x, double y, double yaw_deg);
+  std::uint32_t request_move(const std::string& robot_id, double x, double y,
+                             double yaw_deg) override;
   // Bridges currently subscribed to scan commands, less those whose liveliness was lost (DDS
   // keeps a killed bridge matched until its 10 s participant lease ends).
   int connected_bridges() const;
@@ -78,10 +63,10 @@ class DdsLink {
   void publish_candidates(const PlanRecord& plan);
   // Where the operator sent `robot` (PoseStamped), on rt/scanplan/goal and
   // rt/<robot>/scanplan/goal.
-  void publish_goal(const std::string& robot, const Pose& goal);
-  void publish_annotation(const Annotation& annotation);
+  void publish_goal(const std::string& robot, const Pose& goal) override;
+  void publish_annotation(const Annotation& annotation) override;
   // Disposes and unregisters a deleted annotation, so late joiners no longer get it.
-  void withdraw_annotation(std::int64_t id);
+  void withdraw_annotation(std::int64_t id) override;
 
   // False once the robot's bridge is lost, until it (or a new one with its id) is back.
   bool robot_connected(const std::string& robot_id) const;
@@ -92,19 +77,8 @@ class DdsLink {
   std::function<void(const RobotLoss& loss)> on_robot_lost;
   std::function<void(const std::string& robot)> on_robot_back;
 
-  // The reason a scan lost with its bridge is reported with.
-  static constexpr const char* kScanLostReason = "bridge lost during the scan";
-
  private:
-  // The parts of one scan, which travel on four topics and may arrive in any order.
-  struct PartialScan {
-    std::optional<PointCloud> points;
-    std::optional<Pose> pose;
-    std::optional<std::vector<std::uint8_t>> jpeg;
-    std::optional<PanoramaCamera> camera;
-    std::chrono::steady_clock::time_point first_seen = std::chrono::steady_clock::now();
-  };
-  using Key = std::pair<std::string, std::int64_t>;  // robot id, stamp
+  using Key = ScanAssembly::Key;
 
   // One liveliness change of one writer, as the listener saw it.
   struct LivelinessEvent {
@@ -113,10 +87,10 @@ class DdsLink {
     bool alive;
     BridgeLiveness::Cause cause;
   };
-  // A scan command sent and not yet settled, per robot: "requested", "scanning", "done".
+  // A scan command sent and not yet settled, per robot: requested, scanning or done.
   struct AwaitedScan {
     std::uint32_t command_id = 0;
-    std::string state;
+    ScanState state = ScanState::kRequested;
     float fraction = 0;
   };
 
@@ -128,8 +102,6 @@ class DdsLink {
   void lose_robot(const std::string& robot, const std::string& reason);
   // Whether a sample comes from a bridge already counted as lost (taken after its lease ran out).
   bool from_lost_bridge(const dds_sample_info_t& info) const;
-  // The parts of scan `key`, or null for a scan discarded with its bridge.
-  PartialScan* part(const Key& key);
   // One robot's own latched topics (docs/dds.md "Several robots"), made on first use.
   struct RobotWriters {
     dds_entity_t candidates = 0, goal = 0;  // 0 where the id cannot name a topic
@@ -140,12 +112,16 @@ class DdsLink {
 
   void loop();
   void take_samples();
+  void take_progress();
+  void take_status();
+  // The four parts of scans, into the assembly.
+  void take_scan_parts();
   // Stores every scan whose points and pose are in, once its panorama is in too or it has
   // waited long enough for one (a robot without a camera, or a lost image).
   void complete_scans();
-  void store_scan(const Key& key, PartialScan& scan);
+  void store_scan(AssembledScan& scan);
 
-  ScanStore& store_;
+  RobotBoard& robots_;
   ScanIntake& intake_;
   const Events& events_;
   // Declared before the participant so that they outlive its readers and their listener.
@@ -161,8 +137,7 @@ class DdsLink {
   std::thread thread_;
   std::mutex command_mutex_;
   std::uint32_t next_command_id_ = 1;
-  std::map<Key, PartialScan> partial_;  // only touched by the DDS thread
-  std::deque<Key> discarded_;           // scans dropped with their bridge; DDS thread only
+  ScanAssembly assembly_;  // only touched by the DDS thread
   mutable std::mutex awaited_mutex_;
   std::map<std::string, AwaitedScan> awaited_;  // by robot, under awaited_mutex_
   std::mutex robot_writers_mutex_;

@@ -7,8 +7,8 @@
 #include <thread>
 #include <utility>
 
-#include "events.hpp"
-#include "scan_store.hpp"
+#include "app/events.hpp"
+#include "app/live_map.hpp"
 #include "storage/session_store.hpp"
 
 namespace scanplan::server {
@@ -18,7 +18,7 @@ namespace scanplan::server {
 // so neither the network thread nor the DDS thread waits on the map, the layers or Draco.
 class ScanIntake {
  public:
-  ScanIntake(SessionStore& session, ScanStore& live, const Events& events);
+  ScanIntake(SessionStore& session, LiveMap& live, const Events& events);
   ~ScanIntake();
   ScanIntake(const ScanIntake&) = delete;
   ScanIntake& operator=(const ScanIntake&) = delete;
@@ -42,7 +42,7 @@ class ScanIntake {
   StoredScan match(StoredScan scan, const PointCloud& cloud);
 
   SessionStore& session_;
-  ScanStore& live_;
+  LiveMap& live_;
   const Events& events_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;

@@ -1,24 +1,19 @@
-#include "events.hpp"
+#include "app/events.hpp"
 
 #include <spdlog/spdlog.h>
 
 #include <chrono>
 #include <ctime>
 
+#include "common/iso_time.hpp"
 #include "http/websocket_hub.hpp"
 
 namespace scanplan::server {
 
 void Events::publish(const std::string& type, nlohmann::json data) const {
   if (!hub_) return;
-  const auto now = std::chrono::system_clock::now();
-  const std::time_t t = std::chrono::system_clock::to_time_t(now);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char at[32];
-  std::strftime(at, sizeof at, "%Y-%m-%dT%H:%M:%SZ", &tm);
   data["type"] = type;
-  data["at"] = at;
+  data["at"] = iso8601_utc_now();
   try {
     hub_->broadcast_text(data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   } catch (const std::exception& e) {

@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "app/plan_book.hpp"
 #include "scanplan/geometry/point_cloud.hpp"
 #include "scanplan/geometry/pose.hpp"
 #include "scanplan/geometry/voxel_filter.hpp"
@@ -23,59 +24,9 @@
 
 namespace scanplan::server {
 
-// What the session knows of one robot's current scan.
-struct RobotScanState {
-  std::uint32_t command_id = 0;
-  std::string state = "idle";  // idle, scanning, done, failed
-  float fraction = 0;
-  std::string message;
-};
-
-// What the robot last said about itself (scanplan_RobotStatus).
-struct RobotStatus {
-  std::uint32_t command_id = 0;
-  std::string state = "unknown";  // idle, moving, arrived, refused, scanning
-  std::string message;
-  Pose reported;
-};
-
-// Whether the robot's bridge is alive on DDS (its liveliness lease, docs/dds.md).
-struct RobotConnection {
-  bool connected = true;
-  std::string lost_at;  // UTC, ISO 8601; empty while connected
-  std::string reason;   // why it was lost; empty while connected
-};
-
-struct RobotState {
-  RobotStatus status;
-  RobotScanState scan;
-  RobotConnection connection;
-};
-
 // Areas of the target region's C / M / U segmentation and of the movable region (m²).
 struct MapAreas {
   double completed_m2 = 0, low_resolution_m2 = 0, unscanned_m2 = 0, movable_m2 = 0;
-};
-
-// One suggested scan point as the operator sees it.
-struct CandidateRecord {
-  std::uint64_t id = 0;  // unique in the session, across plans
-  int rank = 0;          // 1 = best
-  Candidate candidate;
-  // proposed, moving, rejected, refused, reached, cancelled, interrupted, superseded
-  std::string state = "proposed";
-  std::string note;     // why, for refused
-  bool custom = false;  // proposed by the operator (POST /api/v1/goals), not by the planner
-};
-
-struct PlanRecord {
-  std::uint64_t id = 0;
-  std::int64_t based_on_scan = 0;
-  std::string robot;
-  std::string policy;
-  double alpha = 0;
-  double plan_ms = 0;
-  std::vector<CandidateRecord> candidates;
 };
 
 // Where the top-view layers lie in the map: the image spans min.x..max.x left to right and
@@ -99,9 +50,6 @@ class GoalRefused : public std::runtime_error {
       : std::runtime_error(message), code(std::move(code)) {}
   std::string code;
 };
-// The heading a robot takes at candidate `c`: along the last leg of its path, so the scan starts
-// looking where the robot went (0 without a path). Degrees, map frame.
-double approach_yaw_deg(const Candidate& c);
 
 // What the operator can change while the mission runs (PUT /api/v1/params).
 struct MissionParams {
@@ -110,16 +58,17 @@ struct MissionParams {
 };
 
 // The scans of this session, in the map frame, with what is derived from them: each scan's
-// Draco chunk, the MLS map with its regions, the top-view layers as PNG and the plan, rebuilt
-// off the network thread each time a scan lands and published together. The whole map's Draco
+// Draco chunk, the MLS map with its regions (the mission pipeline), the top-view layers as PNG
+// and each robot's plan (into the plan book), rebuilt off the network thread each time a scan
+// lands and published together. The whole map's Draco
 // encoding grows with the session (seconds for millions of points), so it is made on a thread
 // of its own after the scan is published: new candidates never wait for it.
-class ScanStore {
+class LiveMap {
  public:
-  explicit ScanStore(MissionConfig config = {});
-  ~ScanStore();
-  ScanStore(const ScanStore&) = delete;
-  ScanStore& operator=(const ScanStore&) = delete;
+  explicit LiveMap(PlanBook& plans, MissionConfig config = {});
+  ~LiveMap();
+  LiveMap(const LiveMap&) = delete;
+  LiveMap& operator=(const LiveMap&) = delete;
 
   // Side of the cubes the map is thinned to for subscribers who take the whole map at once
   // (DDS rt/scanplan/map): 0.3 m keeps walls, doorways and cars recognisable, and the yard
@@ -135,8 +84,9 @@ class ScanStore {
   std::function<void(const PlanRecord& plan)> on_plan;
 
   // A stored scan joins the map: `cloud` is in the scan's own frame, `scan.placed` puts it in
-  // the map frame. Scans must come in id order.
-  void add(const StoredScan& scan, const PointCloud& cloud);
+  // the map frame. Scans must come in id order. Returns the plans made after it (one per robot
+  // not driving to a goal; the scanning robot's last).
+  std::vector<PlanRecord> add(const StoredScan& scan, const PointCloud& cloud);
 
   std::vector<StoredScan> scans() const;
   // Where a new scan goes: matched against the map so far (MissionPipeline::place). Nothing when
@@ -171,30 +121,17 @@ class ScanStore {
   // The areas right after scan `id` joined the map (nothing for an unknown id).
   std::optional<MapAreas> areas_after(std::int64_t id) const;
 
-  // Robot `robot`'s current plan; empty: that of the robot whose scan came last. Nothing before
-  // the robot's first scan.
-  std::optional<PlanRecord> plan(const std::string& robot = "") const;
-  // Every robot's current plan, by robot id.
-  std::vector<PlanRecord> plans() const;
   // Adds the operator's own goal at (x, y) to `robot`'s plan (empty: the robot whose scan came
   // last) as a custom candidate (rank 0), with F (Eq. 1, the other robots' goals claimed) and
   // the drive there over the movable region from the robot's last scan point.
   // Throws GoalRefused when there is no plan yet or the robot cannot stand or get there.
   CandidateRecord add_goal(double x, double y, const std::string& robot = "");
-  // Sets a candidate's state; false when the id is in no current plan.
-  bool set_candidate_state(std::uint64_t id, const std::string& state,
-                           const std::string& note = "");
   MissionParams params() const;
   // How far apart two robots' goals must be (PlannerConfig::claim_separation_m), without
   // waiting for a plan being made.
   double claim_separation_m() const { return claim_separation_m_.load(); }
   // Applies new parameters and recomputes regions, layers and the plan.
   void set_params(const MissionParams& params);
-
-  void set_scan_state(const std::string& robot_id, RobotScanState state);
-  void set_robot_status(const std::string& robot_id, RobotStatus status);
-  void set_robot_connection(const std::string& robot_id, RobotConnection connection);
-  std::map<std::string, RobotState> robot_states() const;
 
  private:
   mutable std::mutex mutex_;
@@ -218,11 +155,8 @@ class ScanStore {
   MissionPipeline mission_;                         // written only under encode_mutex_
   std::pair<std::int64_t, std::string> last_scan_;  // id and robot; under encode_mutex_
   std::map<std::string, Pose> scan_pose_of_;  // each robot's last scan pose; under encode_mutex_
-  std::uint64_t next_plan_id_ = 1, next_candidate_id_ = 1;  // under encode_mutex_
-  std::map<std::string, PlanRecord> plans_;                 // by robot
-  std::string latest_robot_;                                // whose scan came last
+  PlanBook& plans_;
   std::atomic<double> claim_separation_m_;
-  std::map<std::string, RobotState> robots_;
   mutable std::mutex encode_mutex_;  // one writer at a time; readers keep the previous result
   std::thread encoder_;              // last member: starts once everything else exists
 
@@ -234,10 +168,11 @@ class ScanStore {
   // whatever `commit` changes (run under mutex_); needs encode_mutex_ held. Returns the new
   // plans, that of the robot whose scan came last last (none when there is no map to plan on).
   std::vector<PlanRecord> refresh_derived(const std::function<void()>& commit);
-  // Where the robots other than `robot` are going to scan next: the goals of approved moves,
-  // else the best candidates of their plans. Needs mutex_ held.
-  std::vector<Eigen::Vector3d> claims_except(const std::string& robot) const;
-  CandidateRecord* find_candidate(std::uint64_t id);  // needs mutex_ held
+  // One plan per robot not driving to a goal, the driving robots' goals claimed first; that of
+  // the robot whose scan came last last. Needs encode_mutex_ held.
+  std::vector<PlanRecord> make_plans() const;
+  // The top-view layers of the map as it stands. Needs encode_mutex_ held.
+  std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> render_layers() const;
 };
 
 }  // namespace scanplan::server

@@ -1,0 +1,47 @@
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "app/live_map.hpp"
+#include "app/mission.hpp"
+#include "app/plan_book.hpp"
+#include "app/robot_board.hpp"
+#include "scanplan/registration/map_matcher.hpp"
+#include "storage/session_store.hpp"
+
+// The JSON of the session's domain types, in one place: what the REST API answers, what the
+// WebSocket events carry and what the session's event log records are the same encodings
+// (docs/api.md).
+namespace scanplan::server {
+
+nlohmann::json pose_json(const Pose& p);  // {x, y, z, yaw_deg}
+nlohmann::json areas_json(const MapAreas& a);
+nlohmann::json layer_geometry_json(const LayerGeometry& g);
+nlohmann::json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas);
+nlohmann::json candidate_json(const CandidateRecord& r, const std::string& robot,
+                              std::uint64_t plan);
+// A plan without its candidates: {id, based_on_scan, robot, policy, alpha, plan_ms, candidates}.
+nlohmann::json plan_header_json(const PlanRecord& p);
+nlohmann::json robot_json(const RobotState& r);
+nlohmann::json annotation_json(const Annotation& a);
+nlohmann::json params_json(const MissionParams& p);
+
+nlohmann::json approval_json(const Approval& a);
+nlohmann::json rejection_json(const Rejection& r);
+nlohmann::json cancellation_json(const Cancellation& c);
+// The "goal" record of the operator's own point.
+nlohmann::json proposal_json(const Proposal& p, const std::string& by);
+// One entry of the decision log: the recorded details with {id, at, kind}.
+nlohmann::json decision_json(const SessionEvent& e);
+
+// Event payloads (docs/api.md "Events").
+nlohmann::json match_done_json(std::int64_t scan, const Pose& estimated, const MapMatch& m);
+nlohmann::json map_updated_json(const StoredScan& scan, const MapAreas& a);
+nlohmann::json plan_done_json(const PlanRecord& plan);
+nlohmann::json scan_progress_json(const std::string& robot, const RobotScanState& s);
+nlohmann::json robot_status_json(const std::string& robot, const RobotStatus& s);
+
+}  // namespace scanplan::server

@@ -1,0 +1,201 @@
+// scanplan-server: the operator workstation (DESIGN.md "Processes").
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <array>
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
+#include <iostream>
+#include <memory>
+#include <thread>
+#include <vector>
+
+#include "app/annotations.hpp"
+#include "app/events.hpp"
+#include "app/live_map.hpp"
+#include "app/mission.hpp"
+#include "app/plan_book.hpp"
+#include "app/robot_board.hpp"
+#include "app/scan_intake.hpp"
+#include "dds/dds_link.hpp"
+#include "http/http_server.hpp"
+#include "http/router.hpp"
+#include "http/static_files.hpp"
+#include "http/websocket_hub.hpp"
+#include "rest/api.hpp"
+#include "rest/auth.hpp"
+
+#ifndef SCANPLAN_DEFAULT_WEB_DIR
+#define SCANPLAN_DEFAULT_WEB_DIR "web/dist"
+#endif
+
+namespace {
+
+// The HTTP loops a signal stops; filled before the handlers are installed, then only read.
+constexpr int kMaxHttpThreads = 8;
+std::array<scanplan::http::HttpServer*, kMaxHttpThreads> g_servers{};
+void on_signal(int) {
+  for (auto* s : g_servers) {
+    if (s) s->stop();
+  }
+}
+
+std::string env_or_empty(const char* name) {
+  const char* v = std::getenv(name);
+  return v ? v : "";
+}
+
+namespace http = scanplan::http;
+namespace srv = scanplan::server;
+
+struct Options {
+  std::string session_dir, listen = "127.0.0.1:8080", web_dir = SCANPLAN_DEFAULT_WEB_DIR;
+  std::uint32_t domain = 0;
+  // One event loop per core by default: the page, the terminal clients and the other robots'
+  // tools poll the API while scans are processed on other threads.
+  int http_threads = static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 4u));
+};
+
+void add_options(CLI::App& app, Options& o) {
+  app.add_option("--session", o.session_dir, "session directory")->required();
+  app.add_option("--listen", o.listen, "HTTP address host:port (port 0 picks a free one)")
+      ->capture_default_str();
+  app.add_option("--domain", o.domain, "DDS domain id")->capture_default_str();
+  app.add_option("--web", o.web_dir, "directory of the built web page")->capture_default_str();
+  app.add_option("--http-threads", o.http_threads, "HTTP event loops sharing the port")
+      ->capture_default_str()
+      ->check(CLI::Range(1, kMaxHttpThreads));
+}
+
+http::ServerConfig server_config(const Options& o) {
+  const auto colon = o.listen.rfind(':');
+  if (colon == std::string::npos) throw std::runtime_error("--listen must be host:port");
+  http::ServerConfig config;
+  config.host = o.listen.substr(0, colon);
+  const int port = std::stoi(o.listen.substr(colon + 1));
+  if (port < 0 || port > 65535) throw std::runtime_error("--listen port must be 0..65535");
+  config.port = static_cast<std::uint16_t>(port);
+  // Handlers run on several loop threads at once: the API holds no state of its own and the
+  // map, plans, mission, intake and hub guard theirs. The connection limit is shared among them.
+  config.reuse_port = o.http_threads > 1;
+  config.limits.max_connections =
+      std::max<std::size_t>(1, config.limits.max_connections / o.http_threads);
+  return config;
+}
+
+// Runs `count` HTTP loops on one port until a signal or a failing loop stops them.
+void serve(http::ServerConfig config, int count, const http::Router& router,
+           const std::function<void(std::uint16_t port)>& listening) {
+  std::vector<std::unique_ptr<http::HttpServer>> servers;
+  for (int k = 0; k < count; ++k) {
+    servers.push_back(std::make_unique<http::HttpServer>(
+        config, [&router](const http::Request& r) { return router.route(r); }));
+    servers.back()->start();
+    config.port = servers.front()->port();
+  }
+  for (std::size_t k = 0; k < servers.size(); ++k) g_servers[k] = servers[k].get();
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  std::signal(SIGPIPE, SIG_IGN);
+  listening(config.port);
+  std::vector<std::thread> loops;
+  for (std::size_t k = 1; k < servers.size(); ++k) {
+    loops.emplace_back([&servers, k] {
+      try {
+        servers[k]->run();
+      } catch (const std::exception& e) {
+        spdlog::error("HTTP loop {}: {}", k, e.what());
+      }
+      // One loop failing takes the others down: a half-served port is worse than a clear exit.
+      for (auto& s : servers) s->stop();
+    });
+  }
+  const auto stop_loops = [&] {
+    for (auto& s : servers) s->stop();
+    for (auto& t : loops) t.join();
+    g_servers.fill(nullptr);
+  };
+  try {
+    servers.front()->run();
+  } catch (...) {
+    stop_loops();
+    throw;
+  }
+  stop_loops();
+}
+
+// The whole server: storage, the application, DDS and HTTP, wired and run until stopped.
+void run(const Options& o) {
+  std::string operator_token = env_or_empty("SCANPLAN_OPERATOR_TOKEN");
+  const bool generated = operator_token.empty();
+  if (generated) operator_token = srv::Auth::random_token();
+  const srv::Auth auth(operator_token, env_or_empty("SCANPLAN_VIEWER_TOKEN"));
+
+  scanplan::SessionStore session(o.session_dir);
+  http::HubConfig hub_config;
+  // A dense scan's Draco chunk is a few MB; a browser may lag one or two behind.
+  hub_config.max_queued_binary_bytes = 16u << 20;
+  hub_config.log = [](std::string_view msg) { spdlog::warn("events: {}", msg); };
+  http::WebSocketHub hub(hub_config);
+  const srv::Events events(&hub);
+  srv::PlanBook plans;
+  srv::RobotBoard robots;
+  srv::LiveMap map(plans);
+  srv::ScanIntake intake(session, map, events);
+  srv::DdsLink dds(o.domain, robots, intake, events);
+  srv::Mission mission(map, plans, robots, dds, session, events);
+  srv::Annotations annotations(session, dds, events);
+  dds.on_status = [&mission](const std::string& robot, const srv::RobotStatus& status) {
+    mission.on_status(robot, status);
+  };
+  dds.on_robot_lost = [&mission](const srv::RobotLoss& loss) { mission.on_robot_lost(loss); };
+  dds.on_robot_back = [&mission](const std::string& robot) { mission.on_robot_back(robot); };
+  // Wired before the intake starts: the scans it reloads after a restart republish the map
+  // and the plan for DDS subscribers.
+  map.on_map = [&dds](const scanplan::PointCloud& points) { dds.publish_map(points); };
+  map.on_plan = [&dds](const srv::PlanRecord& plan) { dds.publish_candidates(plan); };
+  annotations.republish();
+
+  srv::Api api({map, plans, robots, intake, dds, mission, annotations, hub}, auth, o.session_dir);
+  http::Router router([](std::string_view msg) { spdlog::error("{}", msg); });
+  api.install(router);
+  const http::StaticFiles files(o.web_dir);
+  router.set_fallback(
+      [&files](const http::Request& r, const http::Router::Params&) { return files.serve(r); });
+
+  const http::ServerConfig config = server_config(o);
+  serve(config, o.http_threads, router, [&](std::uint16_t port) {
+    hub.start();
+    intake.start();
+    dds.start();
+    const std::string url = "http://" + config.host + ":" + std::to_string(port) + "/";
+    std::cout << "scanplan-server listening on " << url << std::endl;
+    if (generated)
+      std::cout << "operator link: " << url << "?token=" << operator_token << std::endl;
+  });
+  dds.stop();
+  intake.stop();
+  hub.stop();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"scanplan-server: 3-D mapping workstation for search and rescue"};
+  Options options;
+  add_options(app, options);
+  CLI11_PARSE(app, argc, argv);
+  spdlog::set_default_logger(spdlog::stderr_color_mt("server"));
+  try {
+    run(options);
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
+  spdlog::info("stopped");
+  return 0;
+}

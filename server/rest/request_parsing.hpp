@@ -1,0 +1,35 @@
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "http/request.hpp"
+
+// Reading requests: each function throws http::HttpError 400 naming what is wrong.
+namespace scanplan::server::rest {
+
+// A scan id from the query: a whole number >= 0.
+std::int64_t query_scan_id(const http::Request& r, const std::string& name);
+// A required, finite number from the query string.
+double query_number(const http::Request& r, const std::string& name);
+// A positive whole number from the path (`what` names it in the message).
+std::uint64_t path_id(const std::string& text, const char* what);
+// The request body as a JSON object; `shape` tells the client what is expected.
+nlohmann::json object_body(const http::Request& request, const char* shape);
+// body[key] as a number within lo..hi.
+double number_in(const nlohmann::json& body, const char* key, double lo, double hi);
+// body[key] as a coordinate in metres in the map frame, within ±kMaxCoordinateM.
+double coordinate(const nlohmann::json& body, const char* key);
+// Who decided, for decisions and goals: "operator", or "operator NAME" when the body names one
+// (at most 100 bytes; an empty name counts as none).
+std::string decided_by(const nlohmann::json& body);
+// Who acts, recorded as decisions are: "operator", or "operator NAME" for the body's "by"
+// (1 to `max_bytes` bytes).
+std::string author_of(const nlohmann::json& body, std::size_t max_bytes = 64);
+
+// A coordinate beyond this is a unit mistake (millimetres, a GPS longitude in the wrong field),
+// not a place.
+inline constexpr double kMaxCoordinateM = 1e6;
+
+}  // namespace scanplan::server::rest

@@ -1,0 +1,130 @@
+#include "rest/api.hpp"
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
+
+#include "app/domain_json.hpp"
+#include "http/http_error.hpp"
+#include "rest/request_parsing.hpp"
+#include "scanplan/io/scan_file.hpp"
+
+namespace scanplan::server {
+
+using http::HttpError;
+using http::Request;
+using http::Response;
+using nlohmann::json;
+using rest::query_number;
+using rest::query_scan_id;
+
+Response Api::map_drc(const Request& request) const {
+  LiveMap::EncodedMap encoded;
+  const bool has_since = request.query.count("since") > 0;
+  const bool has_until = request.query.count("until") > 0;
+  if (has_until) {
+    const std::int64_t since = has_since ? query_scan_id(request, "since") : 0;
+    const std::int64_t until = query_scan_id(request, "until");
+    if (until < since) {
+      throw HttpError(400, "bad_request", "'until' must not be less than 'since'");
+    }
+    encoded = app_.map.encoded_range(since, until);
+  } else if (has_since) {
+    encoded = app_.map.encoded_since(query_scan_id(request, "since"));
+  } else {
+    encoded = app_.map.encoded_map();
+  }
+  Response r;
+  if (encoded.draco) {
+    r = Response::bytes(*encoded.draco, "application/octet-stream");
+  } else {
+    r.status = 204;
+  }
+  r.set_header("Cache-Control", "no-store");
+  // The newest scan included, for the next ?since=.
+  r.set_header("X-Scanplan-Last-Scan", std::to_string(encoded.last_scan));
+  return r;
+}
+
+Response Api::layer(const std::string& name) const {
+  const auto& names = LiveMap::layer_names();
+  if (std::find(names.begin(), names.end(), name) == names.end()) {
+    throw HttpError(404, "unknown_layer",
+                    "no layer '" + name + "'; the layers are regions, elevation and movable");
+  }
+  const LayerImage image = app_.map.layer(name);
+  if (!image.png) {
+    Response empty;
+    empty.status = 204;
+    return empty;
+  }
+  const auto& png = *image.png;
+  Response r = Response::bytes(std::string(png.begin(), png.end()), "image/png");
+  r.set_header("Cache-Control", "no-store");
+  // Where the image lies in the map: its left, bottom, right and top edges in metres.
+  const LayerGeometry& g = image.geometry;
+  r.set_header("X-Scanplan-Layer-Bounds", std::to_string(g.min_x) + "," + std::to_string(g.min_y) +
+                                              "," + std::to_string(g.max_x) + "," +
+                                              std::to_string(g.max_y));
+  return r;
+}
+
+Response Api::post_scan(const Request& request) {
+  Pose estimated;
+  estimated.x = query_number(request, "x");
+  estimated.y = query_number(request, "y");
+  estimated.z = query_number(request, "z");
+  estimated.yaw = deg2rad(query_number(request, "yaw_deg"));
+  std::string robot = "robot1";
+  if (const auto it = request.query.find("robot"); it != request.query.end()) robot = it->second;
+  if (robot.empty() || robot.size() > 64 || robot.find('/') != std::string::npos) {
+    throw HttpError(400, "bad_request", "'robot' must be 1 to 64 characters without '/'");
+  }
+  if (request.body.empty()) {
+    throw HttpError(400, "bad_request", "the body must be the scan as a PLY or PCD file");
+  }
+  PointCloud cloud;
+  try {
+    cloud = read_point_cloud_bytes(request.body, "the uploaded scan");
+  } catch (const ScanFileError& e) {
+    throw HttpError(400, "bad_scan", e.what());
+  }
+  if (cloud.empty()) throw HttpError(400, "bad_scan", "the uploaded scan holds no valid points");
+  const auto stamp = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                         std::chrono::system_clock::now().time_since_epoch())
+                         .count();
+  try {
+    const StoredScan s = app_.intake.submit(robot, estimated, stamp, std::move(cloud));
+    return Response::json(201, scan_json(s, std::nullopt));
+  } catch (const SessionStoreError& e) {
+    throw HttpError(503, "storage_failed",
+                    std::string("the scan could not be stored: ") + e.what());
+  }
+}
+
+Response Api::list_scans() const {
+  json list = json::array();
+  for (const StoredScan& s : app_.map.scans())
+    list.push_back(scan_json(s, app_.map.areas_after(s.id)));
+  return Response::json(200, {{"scans", list}, {"pending", app_.intake.pending()}});
+}
+
+Response Api::get_scan(const std::string& id) const {
+  const auto n = static_cast<std::int64_t>(rest::path_id(id, "a scan id"));
+  for (const StoredScan& s : app_.map.scans()) {
+    if (s.id == n) return Response::json(200, scan_json(s, app_.map.areas_after(s.id)));
+  }
+  throw HttpError(404, "not_found", "no scan " + id + " in this session");
+}
+
+Response Api::request_scan(const Request& request) {
+  std::string robot;
+  if (const auto it = request.query.find("robot"); it != request.query.end()) robot = it->second;
+  try {
+    const std::uint32_t id = app_.dds.request_scan(robot);
+    return Response::json(202, {{"command_id", id}, {"robot", robot.empty() ? "*" : robot}});
+  } catch (const NoScannerError& e) {
+    throw HttpError(503, "no_scanner", e.what());
+  }
+}
+
+}  // namespace scanplan::server

@@ -1,0 +1,70 @@
+#include <gtest/gtest.h>
+
+#include "app/plan_book.hpp"
+
+namespace scanplan::server {
+namespace {
+
+CandidateRecord at(std::uint64_t id, int rank, double x) {
+  CandidateRecord c;
+  c.id = id;
+  c.rank = rank;
+  c.candidate.position = {x, 0, 0};
+  return c;
+}
+
+TEST(PlanBook, ANewPlanSupersedesTheUndecidedCandidatesOfTheOld) {
+  PlanBook book;
+  EXPECT_TRUE(book.empty());
+  EXPECT_FALSE(book.plan());
+  book.replace({{1, 1, "a", "paper", 0.5, 1, {at(1, 1, 0), at(2, 2, 5)}}}, "a");
+  book.set_candidate_state(2, CandidateState::kRejected, "no");
+  // The superseded plan is gone from the book; its candidates' states are settled before.
+  book.replace({{2, 2, "a", "paper", 0.5, 1, {at(3, 1, 9)}}}, "a");
+  EXPECT_EQ(book.plan()->id, 2u);
+  EXPECT_FALSE(book.find(1)) << "the old plan was replaced";
+  EXPECT_EQ(book.find(3)->robot, "a");
+  EXPECT_FALSE(book.set_candidate_state(1, CandidateState::kMoving));
+}
+
+TEST(PlanBook, TheLatestRobotsPlanIsTheDefaultAndEachRobotKeepsItsOwn) {
+  PlanBook book;
+  book.replace({{1, 1, "a", "paper", 0.5, 1, {at(1, 1, 0)}}}, "a");
+  book.replace({{2, 2, "b", "paper", 0.5, 1, {at(2, 1, 50)}}}, "b");
+  EXPECT_EQ(book.latest_robot(), "b");
+  EXPECT_EQ(book.plan()->robot, "b");
+  EXPECT_EQ(book.plan("a")->id, 1u);
+  EXPECT_EQ(book.plans().size(), 2u);
+  EXPECT_TRUE(book.add_candidate("a", at(9, 0, 3)));
+  EXPECT_FALSE(book.add_candidate("nobody", at(10, 0, 3)));
+  EXPECT_EQ(book.plan("a")->candidates.size(), 2u);
+}
+
+TEST(PlanBook, ClaimsAreTheOtherRobotsGoalsElseTheirBestCandidates) {
+  PlanBook book;
+  book.replace({{1, 1, "a", "paper", 0.5, 1, {at(1, 1, 0), at(2, 2, 5)}},
+                {2, 1, "b", "paper", 0.5, 1, {at(3, 1, 50), at(4, 2, 60)}}},
+               "b");
+  auto claims = book.claims_except("a");
+  ASSERT_EQ(claims.size(), 1u);
+  EXPECT_EQ(claims[0].x(), 50) << "b's best";
+  book.set_candidate_state(4, CandidateState::kMoving);
+  claims = book.claims_except("a");
+  ASSERT_EQ(claims.size(), 1u);
+  EXPECT_EQ(claims[0].x(), 60) << "b's approved goal";
+  const auto driving = book.driving_goals();
+  ASSERT_EQ(driving.size(), 1u);
+  EXPECT_EQ(driving.at("b").x(), 60);
+  EXPECT_TRUE(book.claims_except("b").size() == 1 && book.claims_except("b")[0].x() == 0);
+}
+
+TEST(PlanBook, IdsAreUniqueAcrossPlans) {
+  PlanBook book;
+  EXPECT_EQ(book.new_plan_id(), 1u);
+  EXPECT_EQ(book.new_plan_id(), 2u);
+  EXPECT_EQ(book.new_candidate_id(), 1u);
+  EXPECT_EQ(book.new_candidate_id(), 2u);
+}
+
+}  // namespace
+}  // namespace scanplan::server
