@@ -5,7 +5,10 @@ PORT ?= 8080
 ROBOTS ?= 1
 WEB_SOURCES := $(wildcard web/src/*) web/index.html web/build.mjs web/package.json
 
-.PHONY: all deps web build test demo format clean
+# In CI (CI set in the environment) warnings are errors.
+CMAKE_FLAGS := -DCMAKE_BUILD_TYPE=Release $(if $(CI),-DSCANPLAN_WERROR=ON,-DSCANPLAN_WERROR=OFF)
+
+.PHONY: all deps web build test demo format check-sanitizers clean
 
 all: build
 
@@ -23,7 +26,7 @@ web/dist/index.html: web/node_modules/.scanplan-installed $(WEB_SOURCES)
 web: deps web/dist/index.html
 
 build: deps web
-	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
+	cmake -S . -B $(BUILD) $(CMAKE_FLAGS)
 	cmake --build $(BUILD) -j$(JOBS)
 
 test: build
@@ -35,5 +38,10 @@ demo: build
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')
 
+# Unit and integration tests under ASan+UBSan, then TSan (build-asan/, build-tsan/); not part of
+# make test. Time on the 2-core machine: docs/architecture.md.
+check-sanitizers: deps web
+	JOBS=$(JOBS) scripts/check-sanitizers.sh
+
 clean:
-	rm -rf $(BUILD) web/dist
+	rm -rf $(BUILD) build-asan build-tsan web/dist

@@ -46,8 +46,8 @@ struct LayerImage {
 // (no_map, outside_target, no_data, not_movable, unreachable).
 class GoalRefused : public std::runtime_error {
  public:
-  GoalRefused(std::string code, const std::string& message)
-      : std::runtime_error(message), code(std::move(code)) {}
+  GoalRefused(std::string code_, const std::string& message)
+      : std::runtime_error(message), code(std::move(code_)) {}
   std::string code;
 };
 

@@ -29,8 +29,8 @@ enum class MissionErrc {
 
 class MissionError : public std::runtime_error {
  public:
-  MissionError(MissionErrc errc, std::string code, const std::string& message)
-      : std::runtime_error(message), errc(errc), code(std::move(code)) {}
+  MissionError(MissionErrc errc_, std::string code_, const std::string& message)
+      : std::runtime_error(message), errc(errc_), code(std::move(code_)) {}
   MissionErrc errc;
   std::string code;  // the machine-readable reason (docs/api.md), e.g. "not_movable"
 };

@@ -7,8 +7,8 @@
 namespace scanplan::cli {
 namespace {
 
-// The fills of core/src/top_view.cpp (BGR). PNG is lossless, so an undrawn pixel has exactly
-// one of these; anti-aliased edges of drawings match none and are left out of the counts.
+// The fills of core/mapping/src/top_view.cpp (BGR). PNG is lossless, so an undrawn pixel has
+// exactly one of these; anti-aliased edges of drawings match none and are left out of the counts.
 struct Fill {
   std::uint8_t b, g, r;
   RegionClass cls;

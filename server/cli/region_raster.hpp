@@ -32,8 +32,8 @@ struct RegionRaster {
 // Decodes GET /api/v1/layers/regions.png. The server draws it over the cells of the target
 // region's bounding box (GET /api/v1/params "target"), `cell_m` metres a cell and `px_per_cell`
 // pixels a cell (docs/api.md: 4 px a 1 m cell), cells indexed by floor(coordinate / cell_m).
-// Each pixel is classified by its exact colour (core/src/top_view.cpp); drawings over the map
-// are kUnknown. Throws std::runtime_error when the bytes are not a PNG or the image's size does
+// Each pixel is classified by its exact colour (core/mapping/src/top_view.cpp); drawings over the
+// map are kUnknown. Throws std::runtime_error when the bytes are not a PNG or the image's size does
 // not fit the target region (a plan made before the target changed).
 RegionRaster decode_regions_png(const std::string& png, double target_min_x, double target_min_y,
                                 double target_max_x, double target_max_y, double cell_m = 1.0,

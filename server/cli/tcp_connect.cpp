@@ -71,7 +71,7 @@ http::UniqueFd connect_tcp(const ServerUrl& url, std::chrono::milliseconds timeo
     last_error = errno;
   }
   char seconds[32];
-  std::snprintf(seconds, sizeof seconds, "%g", timeout.count() / 1000.0);
+  std::snprintf(seconds, sizeof seconds, "%g", static_cast<double>(timeout.count()) / 1000.0);
   const std::string why = last_error == EINPROGRESS || last_error == EAGAIN
                               ? "connection timed out after " + std::string(seconds) + " s"
                               : reason(last_error);

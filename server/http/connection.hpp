@@ -19,11 +19,11 @@ namespace scanplan::http {
 struct Connection {
   using Clock = std::chrono::steady_clock;
 
-  Connection(std::uint64_t id, UniqueFd fd, std::string peer, const Limits& limits,
+  Connection(std::uint64_t id_, UniqueFd fd_, std::string peer_, const Limits& limits,
              Clock::time_point now)
-      : id(id),
-        fd(std::move(fd)),
-        peer(std::move(peer)),
+      : id(id_),
+        fd(std::move(fd_)),
+        peer(std::move(peer_)),
         parser(limits),
         last_activity(now),
         deadline(now) {}

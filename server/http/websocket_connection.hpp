@@ -29,9 +29,9 @@ struct OutgoingFrame {
 struct WebSocketConnection {
   using Clock = std::chrono::steady_clock;
 
-  WebSocketConnection(std::uint64_t id, UniqueFd fd, std::string label,
+  WebSocketConnection(std::uint64_t id_, UniqueFd fd_, std::string label_,
                       std::size_t max_message_bytes)
-      : id(id), fd(std::move(fd)), label(std::move(label)), parser(max_message_bytes) {}
+      : id(id_), fd(std::move(fd_)), label(std::move(label_)), parser(max_message_bytes) {}
 
   bool has_output() const { return sending.has_value() || !control.empty() || !data.empty(); }
 

@@ -47,12 +47,13 @@ int main(int argc, char** argv) {
     const PointCloud back = decode_draco(bytes);
     const double decode_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
-    out["speed_" + std::to_string(speed)] = {{"encode_ms", ms},
-                                             {"decode_ms", decode_ms},
-                                             {"bytes", bytes.size()},
-                                             {"ns_per_point", ms * 1e6 / map.size()},
-                                             {"bytes_per_point", double(bytes.size()) / map.size()},
-                                             {"decoded_points", back.size()}};
+    out["speed_" + std::to_string(speed)] = {
+        {"encode_ms", ms},
+        {"decode_ms", decode_ms},
+        {"bytes", bytes.size()},
+        {"ns_per_point", ms * 1e6 / static_cast<double>(map.size())},
+        {"bytes_per_point", static_cast<double>(bytes.size()) / static_cast<double>(map.size())},
+        {"decoded_points", back.size()}};
   }
   std::printf("%s\n", out.dump().c_str());
 }

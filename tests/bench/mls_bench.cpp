@@ -88,6 +88,49 @@ std::vector<Eigen::Vector3f> placed(const PointCloud& scan, const Pose& pose) {
   return out;
 }
 
+// The scans of the benchmark: five already in the map, across the campus, and the measured one
+// with a finer stage step, so that it holds at least 260k points.
+struct Scans {
+  std::vector<Eigen::Vector2d> earlier = {{80, 45}, {40, 60}, {120, 10}, {150, 90}, {60, 20}};
+  std::vector<std::pair<PointCloud, Pose>> history;
+  PointCloud scan;
+  Pose at;
+};
+
+Scans simulate_scans(const World& world, const RayCaster& caster) {
+  Scans s;
+  for (const auto& xy : s.earlier) {
+    Pose p = world.start;
+    p.x = xy.x();
+    p.y = xy.y();
+    p.z = world.ground_height(p.x, p.y);
+    s.history.emplace_back(simulate_scan(caster, world.scanner, p, s.history.size() + 1), p);
+  }
+  ScannerConfig dense = world.scanner;
+  dense.rotation_step_deg = 0.27;
+  s.at = world.start;
+  s.at.x = 100;
+  s.at.y = 70;
+  s.at.z = world.ground_height(s.at.x, s.at.y);
+  s.scan = simulate_scan(caster, dense, s.at, 99);
+  return s;
+}
+
+// The baseline in the same run: elevation_mapping's per-point fusion of the same scans.
+double elevation_mapping_ms(const World& world, const Scans& s, const Eigen::Vector3d& sensor) {
+  std::optional<ElevationGrid> grid;
+  const std::vector<Eigen::Vector3f> scan_map = placed(s.scan, s.at);
+  const Eigen::Vector3f sensor_map = (s.at.isometry() * sensor).cast<float>();
+  return best_ms(
+      5,
+      [&] {
+        grid.emplace(world.bounds_min, world.bounds_max, 1.0);
+        for (const auto& [c, p] : s.history)
+          grid->add(placed(c, p), (p.isometry() * sensor).cast<float>());
+      },
+      [&] { grid->add(scan_map, sensor_map); });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -96,54 +139,28 @@ int main(int argc, char** argv) {
   const World world = load_world(world_file);
   const RayCaster caster(world);
   const Eigen::Vector3d sensor(0, 0, world.scanner.mount_height_m);
-
-  // Five scans already in the map, across the campus.
-  const std::vector<Eigen::Vector2d> earlier = {{80, 45}, {40, 60}, {120, 10}, {150, 90}, {60, 20}};
-  std::vector<std::pair<PointCloud, Pose>> history;
-  for (const auto& xy : earlier) {
-    Pose p = world.start;
-    p.x = xy.x();
-    p.y = xy.y();
-    p.z = world.ground_height(p.x, p.y);
-    history.emplace_back(simulate_scan(caster, world.scanner, p, history.size() + 1), p);
-  }
-  // The measured scan: a finer stage step, so that it holds at least 260k points.
-  ScannerConfig dense = world.scanner;
-  dense.rotation_step_deg = 0.27;
-  Pose at = world.start;
-  at.x = 100;
-  at.y = 70;
-  at.z = world.ground_height(at.x, at.y);
-  const PointCloud scan = simulate_scan(caster, dense, at, 99);
-  const std::vector<Eigen::Vector3f> scan_map = placed(scan, at);
+  const Scans s = simulate_scans(world, caster);
+  const PointCloud& scan = s.scan;
+  const Pose& at = s.at;
 
   MlsMap map;
   const auto build_history = [&] {
     map = MlsMap();
-    for (const auto& [s, p] : history) map.insert_scan(s, p.isometry(), sensor);
+    for (const auto& [c, p] : s.history) map.insert_scan(c, p.isometry(), sensor);
   };
   const double ms_mls =
       best_ms(5, build_history, [&] { map.insert_scan(scan, at.isometry(), sensor); });
   MlsConfig no_fill_config;
   no_fill_config.fill_between_beams = false;
   MlsMap no_fill(no_fill_config);
+  const std::vector<Eigen::Vector3f> scan_map = placed(scan, at);
   const double ms_mls_no_fill = best_ms(
       5, [&] { no_fill = MlsMap(no_fill_config); }, [&] { no_fill.insert(scan_map); });
-
-  std::optional<ElevationGrid> grid;
-  const Eigen::Vector3f sensor_map = (at.isometry() * sensor).cast<float>();
-  const double ms_elevation = best_ms(
-      5,
-      [&] {
-        grid.emplace(world.bounds_min, world.bounds_max, 1.0);
-        for (const auto& [s, p] : history)
-          grid->add(placed(s, p), (p.isometry() * sensor).cast<float>());
-      },
-      [&] { grid->add(scan_map, sensor_map); });
+  const double ms_elevation = elevation_mapping_ms(world, s, sensor);
 
   build_history();
   map.insert_scan(scan, at.isometry(), sensor);
-  std::vector<Eigen::Vector2d> scan_points = earlier;
+  std::vector<Eigen::Vector2d> scan_points = s.earlier;
   scan_points.push_back({at.x, at.y});
   const TargetRegion target = world.target_region();
   RegionMap regions;
@@ -159,7 +176,7 @@ int main(int argc, char** argv) {
   const double n = static_cast<double>(scan.size());
   const nlohmann::json out = {{"bench", "mls_campus"},
                               {"scan_points", scan.size()},
-                              {"map_scans_before", history.size()},
+                              {"map_scans_before", s.history.size()},
                               {"ms_mls_insert_scan", ms_mls},
                               {"mpts_per_s_mls", n / ms_mls / 1000.0},
                               {"ms_mls_insert_no_fill", ms_mls_no_fill},

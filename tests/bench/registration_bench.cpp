@@ -338,9 +338,8 @@ std::vector<std::string> split(const std::string& s) {
   return out;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+// The command line; nothing (after a message) when it cannot be used.
+std::optional<Args> parse_args(int argc, char** argv) {
   Args a;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
@@ -360,16 +359,38 @@ int main(int argc, char** argv) {
       a.verbose = v == "1";
     } else {
       std::fprintf(stderr, "unknown option %s\n", k.c_str());
-      return 2;
+      return std::nullopt;
     }
   }
   for (const auto& m : a.methods) {
     if (!parse_any_method(m) && m != "ndt-icp-6dof" && m != "ndt-icp-paper-cells" &&
         m != "pcl-ndt+pcl-icp") {
       std::fprintf(stderr, "unknown method %s\n", m.c_str());
-      return 2;
+      return std::nullopt;
     }
   }
+  return a;
+}
+
+// Set aside as ill-posed: no method can be right there, but none should claim it is.
+nlohmann::json evaluate_ill_posed(const std::vector<Pair>& ill, const Args& a,
+                                  std::map<std::string, double>& ms) {
+  std::fprintf(stderr, "ill-posed pairs set aside, %zu\n", ill.size());
+  std::vector<std::string> few;
+  for (const auto& m : {"ndt-icp", "pcl-gicp"}) {
+    if (std::find(a.methods.begin(), a.methods.end(), m) != a.methods.end()) few.push_back(m);
+  }
+  nlohmann::json out = evaluate_set(ill, few, a.verbose, ms);
+  out["pairs"] = ill.size();
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::optional<Args> parsed = parse_args(argc, argv);
+  if (!parsed) return 2;
+  const Args& a = *parsed;
   const Campus campus(a.world);
   std::mt19937_64 rng(a.seed);
 
@@ -406,16 +427,7 @@ int main(int argc, char** argv) {
   }
   std::vector<Pair> ill = normal.ill_posed;
   for (const auto& p : hard.ill_posed) ill.push_back(p);
-  if (!ill.empty()) {
-    // Set aside as ill-posed: no method can be right there, but none should claim it is.
-    std::fprintf(stderr, "ill-posed pairs set aside, %zu\n", ill.size());
-    std::vector<std::string> few;
-    for (const auto& m : {"ndt-icp", "pcl-gicp"}) {
-      if (std::find(a.methods.begin(), a.methods.end(), m) != a.methods.end()) few.push_back(m);
-    }
-    out["ill_posed"] = evaluate_set(ill, few, a.verbose, ms_ill);
-    out["ill_posed"]["pairs"] = ill.size();
-  }
+  if (!ill.empty()) out["ill_posed"] = evaluate_ill_posed(ill, a, ms_ill);
   if (ms_normal.count("ndt-icp") && ms_normal.count("pcl-ndt+pcl-icp")) {
     out["speedup_vs_pcl_ndt_then_icp"] = ms_normal["pcl-ndt+pcl-icp"] / ms_normal["ndt-icp"];
   }

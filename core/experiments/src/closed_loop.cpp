@@ -29,6 +29,33 @@ std::vector<CellIndex> reachable_ground_cells(const World& world, const WorldTra
   return out;
 }
 
+// The share of `ground` the regions count as scan-completed, in per cent.
+double coverage_pct(const RegionMap& regions, const std::vector<CellIndex>& ground) {
+  std::size_t covered = 0;
+  for (const CellIndex& c : ground) covered += regions.at(c) == Region::kCompleted;
+  return ground.empty() ? 0.0
+                        : 100.0 * static_cast<double>(covered) / static_cast<double>(ground.size());
+}
+
+// The operator approving the best suggestion the robot can really reach: the first ranked
+// candidate reachable in the true world (the map was built from noisy poses, so a suggestion
+// may not be drivable). Moves `truth` there and adds the drive to `path_m`.
+std::optional<std::size_t> drive_to_best(const WorldTraversability& trav,
+                                         const std::vector<Candidate>& ranked, Pose& truth,
+                                         double& path_m) {
+  const auto reach = trav.reach_from(truth.x, truth.y, truth.z);
+  for (std::size_t k = 0; k < ranked.size(); ++k) {
+    const Eigen::Vector3d& goal = ranked[k].position;
+    const auto cell = trav.cell_of(goal.x(), goal.y());
+    if (cell && reach.reachable(*cell)) {
+      path_m += reach.distance_m[*cell];
+      truth = trav.standing_pose(goal.x(), goal.y(), reach.z[*cell], truth.yaw);
+      return k;
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 LoopResult run_closed_loop(
@@ -37,14 +64,14 @@ LoopResult run_closed_loop(
   const RayCaster caster(world);
   const WorldTraversability trav(world, caster);
   Pose truth = trav.standing_pose(world.start.x, world.start.y, world.start.z, world.start.yaw);
-  const auto reach_from_start = trav.reach_from(truth.x, truth.y, truth.z);
 
   MissionConfig mission_config{config.pipeline, config.planner, config.matching};
   mission_config.mapping.sensor_height_m = world.scanner.mount_height_m;
   MissionPipeline mission(mission_config);
   mission.set_target(world.target_region());
   const MappingPipeline& pipeline = mission.mapping();
-  const auto ground = reachable_ground_cells(world, trav, reach_from_start, pipeline.map());
+  const auto ground = reachable_ground_cells(
+      world, trav, trav.reach_from(truth.x, truth.y, truth.z), pipeline.map());
 
   LoopResult result;
   result.reachable_cells = ground.size();
@@ -67,9 +94,7 @@ LoopResult run_closed_loop(
     const RegionMap& regions = *pipeline.regions();
     step.detected_m2 = regions.detected_m2();
     step.completed_m2 = regions.completed_m2();
-    std::size_t covered = 0;
-    for (const CellIndex& c : ground) covered += regions.at(c) == Region::kCompleted;
-    step.coverage_pct = ground.empty() ? 0.0 : 100.0 * covered / ground.size();
+    step.coverage_pct = coverage_pct(regions, ground);
     step.path_m = path_m;
     if (!result.scans_to_95pct && step.coverage_pct >= 95.0) {
       result.scans_to_95pct = scan;
@@ -85,17 +110,7 @@ LoopResult run_closed_loop(
       step.plan_ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       step.candidates = plan.ranked;
-      // The map was built from noisy poses: a suggestion may not be drivable in reality.
-      const auto reach = trav.reach_from(truth.x, truth.y, truth.z);
-      for (std::size_t k = 0; k < plan.ranked.size() && !step.chosen; ++k) {
-        const Eigen::Vector3d& goal = plan.ranked[k].position;
-        const auto cell = trav.cell_of(goal.x(), goal.y());
-        if (cell && reach.reachable(*cell)) {
-          step.chosen = k;
-          path_m += reach.distance_m[*cell];
-          truth = trav.standing_pose(goal.x(), goal.y(), reach.z[*cell], truth.yaw);
-        }
-      }
+      step.chosen = drive_to_best(trav, plan.ranked, truth, path_m);
     }
     if (on_step) on_step(step, pipeline);
     result.steps.push_back(std::move(step));

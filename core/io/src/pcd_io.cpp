@@ -78,7 +78,22 @@ class Parser : private text_scan::LineReader {
   PointCloud parse(PcdInfo* info);
 
  private:
+  // What the header's lines said, before they are checked against each other.
+  struct HeaderLines {
+    bool fields = false, size = false, type = false, count = false;
+    bool width = false, height = false, points = false, viewpoint = false;
+    std::vector<std::size_t> sizes, counts;
+    std::vector<char> types;
+  };
   Header parse_header();
+  // One header line; true once it is the DATA line, which ends the header.
+  bool header_line(std::string_view line, Header& h, HeaderLines& seen);
+  void per_field_line(std::string_view key, const std::vector<std::string_view>& args,
+                      HeaderLines& seen);
+  void data_line(const std::vector<std::string_view>& args, Header& h);
+  // The lines checked against each other: one SIZE, TYPE and COUNT per field, WIDTH × HEIGHT
+  // = POINTS.
+  void complete(Header& h, const HeaderLines& seen);
   Layout layout_of(const Header& h) const;
   void read_ascii(const Header& h, const Layout& l, PointCloud& cloud, std::size_t& dropped);
   void read_binary(const Header& h, const Layout& l, PointCloud& cloud, std::size_t& dropped);
@@ -132,99 +147,109 @@ Rgb unpack_rgb(std::uint32_t bits) {
 
 Header Parser::parse_header() {
   Header h;
-  bool have_fields = false, have_size = false, have_type = false, have_count = false;
-  bool have_width = false, have_height = false, have_points = false, have_viewpoint = false;
-  std::vector<std::size_t> sizes, counts;
-  std::vector<char> types;
+  HeaderLines seen;
   std::string_view line;
-  auto once = [&](bool& seen, std::string_view key) {
-    if (seen) fail_line(line_, "a second '" + std::string(key) + "' line");
-    seen = true;
-  };
-  while (true) {
+  do {
     if (!next_line(line)) {
       fail("the header has no 'DATA' line (the file is truncated or not a PCD file)");
     }
-    const auto tok = text_scan::split_ws(line);
-    if (tok.empty() || tok[0].front() == '#') continue;
-    const std::string_view key = tok[0];
-    const auto args = std::vector<std::string_view>(tok.begin() + 1, tok.end());
-    auto parse_count_line = [&](std::uint64_t& out) {
-      if (args.size() != 1 || !text_scan::parse_int(args[0], out)) {
-        fail_line(line_, "'" + std::string(key) + "' needs one non-negative integer");
+  } while (!header_line(line, h, seen));
+  complete(h, seen);
+  return h;
+}
+
+bool Parser::header_line(std::string_view line, Header& h, HeaderLines& seen) {
+  const auto tok = text_scan::split_ws(line);
+  if (tok.empty() || tok[0].front() == '#') return false;
+  const std::string_view key = tok[0];
+  const auto args = std::vector<std::string_view>(tok.begin() + 1, tok.end());
+  auto once = [&](bool& flag, std::string_view name) {
+    if (flag) fail_line(line_, "a second '" + std::string(name) + "' line");
+    flag = true;
+  };
+  auto count_line = [&](bool& flag, std::uint64_t& out) {
+    once(flag, key);
+    if (args.size() != 1 || !text_scan::parse_int(args[0], out)) {
+      fail_line(line_, "'" + std::string(key) + "' needs one non-negative integer");
+    }
+  };
+  if (key == "VERSION") {
+    // 0.5 to 0.7 differ only in optional lines, which are handled below.
+  } else if (key == "FIELDS" || key == "COLUMNS") {
+    once(seen.fields, "FIELDS");
+    if (args.empty()) fail_line(line_, "FIELDS names no fields");
+    for (const auto a : args) h.fields.push_back(Field{std::string(a), 0, 'F', 1});
+  } else if (key == "SIZE" || key == "TYPE" || key == "COUNT") {
+    per_field_line(key, args, seen);
+  } else if (key == "WIDTH") {
+    count_line(seen.width, h.width);
+  } else if (key == "HEIGHT") {
+    count_line(seen.height, h.height);
+  } else if (key == "POINTS") {
+    count_line(seen.points, h.points);
+  } else if (key == "VIEWPOINT") {
+    once(seen.viewpoint, key);
+    if (args.size() != 7) fail_line(line_, "VIEWPOINT needs 7 numbers: tx ty tz qw qx qy qz");
+    for (std::size_t i = 0; i < 7; ++i) {
+      if (!text_scan::parse_double(args[i], h.viewpoint[i])) {
+        fail_line(line_, "VIEWPOINT value '" + std::string(args[i]) + "' is not a number");
       }
-    };
-    if (key == "VERSION") {
-      // 0.5 to 0.7 differ only in optional lines, which are handled below.
-    } else if (key == "FIELDS" || key == "COLUMNS") {
-      once(have_fields, "FIELDS");
-      if (args.empty()) fail_line(line_, "FIELDS names no fields");
-      for (const auto a : args) h.fields.push_back(Field{std::string(a), 0, 'F', 1});
-    } else if (key == "SIZE") {
-      once(have_size, key);
-      for (const auto a : args) {
-        std::size_t s = 0;
-        if (!text_scan::parse_int(a, s) || (s != 1 && s != 2 && s != 4 && s != 8)) {
-          fail_line(line_, "SIZE '" + std::string(a) + "' is not 1, 2, 4 or 8");
-        }
-        sizes.push_back(s);
+    }
+  } else if (key == "DATA") {
+    data_line(args, h);
+    return true;
+  } else {
+    fail_line(line_, "unexpected header line '" + std::string(line.substr(0, 60)) + "'");
+  }
+  return false;
+}
+
+void Parser::per_field_line(std::string_view key, const std::vector<std::string_view>& args,
+                            HeaderLines& seen) {
+  bool& flag = key == "SIZE" ? seen.size : key == "TYPE" ? seen.type : seen.count;
+  if (flag) fail_line(line_, "a second '" + std::string(key) + "' line");
+  flag = true;
+  for (const auto a : args) {
+    if (key == "SIZE") {
+      std::size_t v = 0;
+      if (!text_scan::parse_int(a, v) || (v != 1 && v != 2 && v != 4 && v != 8)) {
+        fail_line(line_, "SIZE '" + std::string(a) + "' is not 1, 2, 4 or 8");
       }
+      seen.sizes.push_back(v);
     } else if (key == "TYPE") {
-      once(have_type, key);
-      for (const auto a : args) {
-        if (a.size() != 1 || (a[0] != 'F' && a[0] != 'I' && a[0] != 'U')) {
-          fail_line(line_, "TYPE '" + std::string(a) + "' is not F, I or U");
-        }
-        types.push_back(a[0]);
+      if (a.size() != 1 || (a[0] != 'F' && a[0] != 'I' && a[0] != 'U')) {
+        fail_line(line_, "TYPE '" + std::string(a) + "' is not F, I or U");
       }
-    } else if (key == "COUNT") {
-      once(have_count, key);
-      for (const auto a : args) {
-        std::size_t c = 0;
-        // The longest descriptors PCL knows have a few hundred values; a million is a lie.
-        if (!text_scan::parse_int(a, c) || c == 0 || c > (1u << 20)) {
-          fail_line(line_, "COUNT '" + std::string(a) + "' is not an integer from 1 to 1048576");
-        }
-        counts.push_back(c);
-      }
-    } else if (key == "WIDTH") {
-      once(have_width, key);
-      parse_count_line(h.width);
-    } else if (key == "HEIGHT") {
-      once(have_height, key);
-      parse_count_line(h.height);
-    } else if (key == "POINTS") {
-      once(have_points, key);
-      parse_count_line(h.points);
-    } else if (key == "VIEWPOINT") {
-      once(have_viewpoint, key);
-      if (args.size() != 7) fail_line(line_, "VIEWPOINT needs 7 numbers: tx ty tz qw qx qy qz");
-      for (std::size_t i = 0; i < 7; ++i) {
-        if (!text_scan::parse_double(args[i], h.viewpoint[i])) {
-          fail_line(line_, "VIEWPOINT value '" + std::string(args[i]) + "' is not a number");
-        }
-      }
-    } else if (key == "DATA") {
-      if (args.size() != 1) fail_line(line_, "expected 'DATA ascii|binary|binary_compressed'");
-      if (args[0] == "ascii") {
-        h.data = PcdData::kAscii;
-      } else if (args[0] == "binary") {
-        h.data = PcdData::kBinary;
-      } else if (args[0] == "binary_compressed") {
-        h.data = PcdData::kBinaryCompressed;
-      } else {
-        fail_line(line_, "unknown DATA '" + std::string(args[0]) +
-                             "' (expected ascii, binary or binary_compressed)");
-      }
-      break;
+      seen.types.push_back(a[0]);
     } else {
-      fail_line(line_, "unexpected header line '" + std::string(line.substr(0, 60)) + "'");
+      std::size_t c = 0;
+      // The longest descriptors PCL knows have a few hundred values; a million is a lie.
+      if (!text_scan::parse_int(a, c) || c == 0 || c > (1u << 20)) {
+        fail_line(line_, "COUNT '" + std::string(a) + "' is not an integer from 1 to 1048576");
+      }
+      seen.counts.push_back(c);
     }
   }
+}
 
-  if (!have_fields) fail("the header has no FIELDS line");
-  if (!have_size) fail("the header has no SIZE line");
-  if (!have_type) fail("the header has no TYPE line");
+void Parser::data_line(const std::vector<std::string_view>& args, Header& h) {
+  if (args.size() != 1) fail_line(line_, "expected 'DATA ascii|binary|binary_compressed'");
+  if (args[0] == "ascii") {
+    h.data = PcdData::kAscii;
+  } else if (args[0] == "binary") {
+    h.data = PcdData::kBinary;
+  } else if (args[0] == "binary_compressed") {
+    h.data = PcdData::kBinaryCompressed;
+  } else {
+    fail_line(line_, "unknown DATA '" + std::string(args[0]) +
+                         "' (expected ascii, binary or binary_compressed)");
+  }
+}
+
+void Parser::complete(Header& h, const HeaderLines& seen) {
+  if (!seen.fields) fail("the header has no FIELDS line");
+  if (!seen.size) fail("the header has no SIZE line");
+  if (!seen.type) fail("the header has no TYPE line");
   const std::size_t n = h.fields.size();
   auto check_len = [&](std::size_t got, const char* what) {
     if (got != n) {
@@ -232,21 +257,20 @@ Header Parser::parse_header() {
            std::to_string(n));
     }
   };
-  check_len(sizes.size(), "SIZE");
-  check_len(types.size(), "TYPE");
-  if (have_count) check_len(counts.size(), "COUNT");
+  check_len(seen.sizes.size(), "SIZE");
+  check_len(seen.types.size(), "TYPE");
+  if (seen.count) check_len(seen.counts.size(), "COUNT");
   for (std::size_t i = 0; i < n; ++i) {
-    h.fields[i].size = sizes[i];
-    h.fields[i].type = types[i];
-    h.fields[i].count = have_count ? counts[i] : 1;
-    if (types[i] == 'F' && sizes[i] != 4 && sizes[i] != 8) {
-      fail("field '" + h.fields[i].name + "' has TYPE F with SIZE " + std::to_string(sizes[i]) +
-           " (floats are 4 or 8 bytes)");
+    h.fields[i].size = seen.sizes[i];
+    h.fields[i].type = seen.types[i];
+    h.fields[i].count = seen.count ? seen.counts[i] : 1;
+    if (seen.types[i] == 'F' && seen.sizes[i] != 4 && seen.sizes[i] != 8) {
+      fail("field '" + h.fields[i].name + "' has TYPE F with SIZE " +
+           std::to_string(seen.sizes[i]) + " (floats are 4 or 8 bytes)");
     }
   }
-
-  if (!have_width && !have_points) fail("the header has neither WIDTH nor POINTS");
-  if (!have_width) {
+  if (!seen.width && !seen.points) fail("the header has neither WIDTH nor POINTS");
+  if (!seen.width) {
     h.width = h.points;
     h.height = 1;
   }
@@ -255,12 +279,11 @@ Header Parser::parse_header() {
     fail("WIDTH " + std::to_string(h.width) + " times HEIGHT " + std::to_string(h.height) +
          " is too large");
   }
-  if (!have_points) h.points = wh;
+  if (!seen.points) h.points = wh;
   if (wh != h.points) {
     fail("POINTS is " + std::to_string(h.points) + " but WIDTH x HEIGHT is " +
          std::to_string(h.width) + " x " + std::to_string(h.height));
   }
-  return h;
 }
 
 Layout Parser::layout_of(const Header& h) const {

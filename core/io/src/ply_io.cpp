@@ -102,6 +102,9 @@ class Parser : private text_scan::LineReader {
 
  private:
   Header parse_header();
+  void format_line(const std::vector<std::string_view>& tok, Header& h);
+  void element_line(const std::vector<std::string_view>& tok, Header& h);
+  void property_line(const std::vector<std::string_view>& tok, Header& h);
   std::vector<Role> vertex_roles(const Element& vertex, bool& has_color) const;
   void skip_binary(const Element& e, bool swap);
   void skip_ascii(const Element& e);
@@ -181,66 +184,11 @@ Header Parser::parse_header() {
     } else if (key == "obj_info") {
       h.obj_info.push_back(rest_after(line, key));
     } else if (key == "format") {
-      if (tok.size() != 3) fail_line(line_, "expected 'format <type> 1.0'");
-      if (h.format) fail_line(line_, "a second 'format' line");
-      if (tok[1] == "ascii") {
-        h.format = PlyFormat::kAscii;
-      } else if (tok[1] == "binary_little_endian") {
-        h.format = PlyFormat::kBinaryLittleEndian;
-      } else if (tok[1] == "binary_big_endian") {
-        h.format = PlyFormat::kBinaryBigEndian;
-      } else {
-        fail_line(line_, "unknown format '" + std::string(tok[1]) +
-                             "' (expected ascii, binary_little_endian or binary_big_endian)");
-      }
-      if (tok[2] != "1.0" && tok[2] != "1") {
-        fail_line(line_, "unsupported PLY version '" + std::string(tok[2]) + "' (expected 1.0)");
-      }
+      format_line(tok, h);
     } else if (key == "element") {
-      if (tok.size() != 3) fail_line(line_, "expected 'element <name> <count>'");
-      Element e;
-      e.name = tok[1];
-      // Unlike the values in an ascii body, a count may not carry a '+'.
-      if (tok[2].starts_with('+') || !text_scan::parse_int(tok[2], e.count)) {
-        fail_line(line_, "element '" + e.name + "' count '" + std::string(tok[2]) +
-                             "' is not a non-negative integer");
-      }
-      for (const auto& other : h.elements) {
-        if (other.name == e.name) fail_line(line_, "a second element named '" + e.name + "'");
-      }
-      h.elements.push_back(std::move(e));
+      element_line(tok, h);
     } else if (key == "property") {
-      if (h.elements.empty()) fail_line(line_, "'property' before any 'element'");
-      Property p;
-      if (tok.size() >= 2 && tok[1] == "list") {
-        if (tok.size() != 5) {
-          fail_line(line_, "expected 'property list <count type> <item type> <name>'");
-        }
-        const auto ct = parse_type(tok[2]);
-        const auto it = parse_type(tok[3]);
-        if (!ct || !is_integer(*ct)) {
-          fail_line(line_, "list count type '" + std::string(tok[2]) + "' is not an integer type");
-        }
-        if (!it) fail_line(line_, "unknown property type '" + std::string(tok[3]) + "'");
-        p.is_list = true;
-        p.count_type = *ct;
-        p.type = *it;
-        p.name = tok[4];
-      } else {
-        if (tok.size() != 3) fail_line(line_, "expected 'property <type> <name>'");
-        const auto t = parse_type(tok[1]);
-        if (!t) fail_line(line_, "unknown property type '" + std::string(tok[1]) + "'");
-        p.type = *t;
-        p.name = tok[2];
-      }
-      auto& props = h.elements.back().properties;
-      for (const auto& other : props) {
-        if (other.name == p.name) {
-          fail_line(line_, "property '" + p.name + "' appears twice in element '" +
-                               h.elements.back().name + "'");
-        }
-      }
-      props.push_back(std::move(p));
+      property_line(tok, h);
     } else {
       fail_line(line_, "unexpected header line '" + std::string(line.substr(0, 60)) + "'");
     }
@@ -249,6 +197,73 @@ Header Parser::parse_header() {
   h.data_offset = pos_;
   h.line_count = line_;
   return h;
+}
+
+void Parser::format_line(const std::vector<std::string_view>& tok, Header& h) {
+  if (tok.size() != 3) fail_line(line_, "expected 'format <type> 1.0'");
+  if (h.format) fail_line(line_, "a second 'format' line");
+  if (tok[1] == "ascii") {
+    h.format = PlyFormat::kAscii;
+  } else if (tok[1] == "binary_little_endian") {
+    h.format = PlyFormat::kBinaryLittleEndian;
+  } else if (tok[1] == "binary_big_endian") {
+    h.format = PlyFormat::kBinaryBigEndian;
+  } else {
+    fail_line(line_, "unknown format '" + std::string(tok[1]) +
+                         "' (expected ascii, binary_little_endian or binary_big_endian)");
+  }
+  if (tok[2] != "1.0" && tok[2] != "1") {
+    fail_line(line_, "unsupported PLY version '" + std::string(tok[2]) + "' (expected 1.0)");
+  }
+}
+
+void Parser::element_line(const std::vector<std::string_view>& tok, Header& h) {
+  if (tok.size() != 3) fail_line(line_, "expected 'element <name> <count>'");
+  Element e;
+  e.name = tok[1];
+  // Unlike the values in an ascii body, a count may not carry a '+'.
+  if (tok[2].starts_with('+') || !text_scan::parse_int(tok[2], e.count)) {
+    fail_line(line_, "element '" + e.name + "' count '" + std::string(tok[2]) +
+                         "' is not a non-negative integer");
+  }
+  for (const auto& other : h.elements) {
+    if (other.name == e.name) fail_line(line_, "a second element named '" + e.name + "'");
+  }
+  h.elements.push_back(std::move(e));
+}
+
+void Parser::property_line(const std::vector<std::string_view>& tok, Header& h) {
+  if (h.elements.empty()) fail_line(line_, "'property' before any 'element'");
+  Property p;
+  if (tok.size() >= 2 && tok[1] == "list") {
+    if (tok.size() != 5) {
+      fail_line(line_, "expected 'property list <count type> <item type> <name>'");
+    }
+    const auto ct = parse_type(tok[2]);
+    const auto it = parse_type(tok[3]);
+    if (!ct || !is_integer(*ct)) {
+      fail_line(line_, "list count type '" + std::string(tok[2]) + "' is not an integer type");
+    }
+    if (!it) fail_line(line_, "unknown property type '" + std::string(tok[3]) + "'");
+    p.is_list = true;
+    p.count_type = *ct;
+    p.type = *it;
+    p.name = tok[4];
+  } else {
+    if (tok.size() != 3) fail_line(line_, "expected 'property <type> <name>'");
+    const auto t = parse_type(tok[1]);
+    if (!t) fail_line(line_, "unknown property type '" + std::string(tok[1]) + "'");
+    p.type = *t;
+    p.name = tok[2];
+  }
+  auto& props = h.elements.back().properties;
+  for (const auto& other : props) {
+    if (other.name == p.name) {
+      fail_line(line_, "property '" + p.name + "' appears twice in element '" +
+                           h.elements.back().name + "'");
+    }
+  }
+  props.push_back(std::move(p));
 }
 
 std::vector<Role> Parser::vertex_roles(const Element& vertex, bool& has_color) const {

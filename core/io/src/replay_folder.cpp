@@ -5,7 +5,9 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <functional>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -87,6 +89,68 @@ ReplayFolder::ReplayFolder(std::filesystem::path dir) : dir_(std::move(dir)) {
   }
 }
 
+namespace {
+
+using ColumnIndex = std::array<int, kColumnCount>;  // cell index of each column, -1 when absent
+using LineFailure = std::function<void(const std::string& what)>;
+
+ColumnIndex header_columns(const std::vector<std::string_view>& cells, const LineFailure& fail) {
+  ColumnIndex index;
+  index.fill(-1);
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    const auto it = std::find(kColumnNames.begin(), kColumnNames.end(), cells[c]);
+    if (it == kColumnNames.end()) {
+      fail("unknown column '" + std::string(cells[c]) +
+           "' (the columns are file,x,y,z,yaw_deg and optionally roll_deg,pitch_deg)");
+    }
+    const auto col = static_cast<std::size_t>(it - kColumnNames.begin());
+    if (index[col] >= 0) fail("column '" + std::string(cells[c]) + "' appears twice");
+    index[col] = static_cast<int>(c);
+  }
+  for (std::size_t col = kFile; col <= kYaw; ++col) {
+    if (index[col] < 0) {
+      fail("the header has no '" + std::string(kColumnNames[col]) +
+           "' column (it needs file,x,y,z,yaw_deg)");
+    }
+  }
+  return index;
+}
+
+// One scan's row: its file (which must exist in `dir`) and pose.
+ReplayFolder::Entry entry_of(const std::vector<std::string_view>& cells, const ColumnIndex& index,
+                             const fs::path& dir, const LineFailure& fail) {
+  std::array<double, kColumnCount> v{};
+  for (std::size_t col = kX; col < kColumnCount; ++col) {
+    if (index[col] < 0) continue;
+    const std::string_view cell = cells[static_cast<std::size_t>(index[col])];
+    if (!parse_double(cell, v[col])) {
+      fail("column '" + std::string(kColumnNames[col]) + "': '" + std::string(cell.substr(0, 40)) +
+           "' is not a finite number");
+    }
+  }
+  const std::string_view name = cells[static_cast<std::size_t>(index[kFile])];
+  if (name.empty()) fail("the 'file' column is empty");
+  const fs::path rel(name);
+  const std::string ext = lower(rel.extension().string());
+  if (ext != ".ply" && ext != ".pcd")
+    fail("scan file '" + std::string(name) + "' is not .ply or .pcd");
+  ReplayFolder::Entry e;
+  e.scan = rel.is_absolute() ? rel : dir / rel;
+  std::error_code ec;
+  if (!fs::is_regular_file(e.scan, ec)) {
+    fail("scan file '" + std::string(name) + "' does not exist in " + dir.string());
+  }
+  e.pose.x = v[kX];
+  e.pose.y = v[kY];
+  e.pose.z = v[kZ];
+  e.pose.yaw = deg2rad(v[kYaw]);
+  e.pose.roll = deg2rad(v[kRoll]);
+  e.pose.pitch = deg2rad(v[kPitch]);
+  return e;
+}
+
+}  // namespace
+
 void ReplayFolder::list_csv(const fs::path& csv) {
   std::string text;
   try {
@@ -94,18 +158,16 @@ void ReplayFolder::list_csv(const fs::path& csv) {
   } catch (const ScanFileError& e) {
     throw ReplayFolderError(e.what());
   }
-  auto fail = [&](std::size_t line, const std::string& what) -> void {
-    throw ReplayFolderError(csv.string() + " line " + std::to_string(line) + ": " + what);
-  };
   // Spreadsheets save CSV with a byte-order mark; it is not part of the first column's name.
   std::string_view rest = text;
   if (rest.starts_with("\xEF\xBB\xBF")) rest.remove_prefix(3);
 
-  std::array<int, kColumnCount> index;  // cell index of each column, -1 when absent
-  index.fill(-1);
+  std::optional<ColumnIndex> index;
   std::size_t columns = 0;
-  bool have_header = false;
   std::size_t line_no = 0;
+  const LineFailure fail = [&](const std::string& what) {
+    throw ReplayFolderError(csv.string() + " line " + std::to_string(line_no) + ": " + what);
+  };
   while (!rest.empty()) {
     const std::size_t nl = rest.find('\n');
     const std::string_view line = trim(rest.substr(0, nl));
@@ -113,66 +175,20 @@ void ReplayFolder::list_csv(const fs::path& csv) {
     ++line_no;
     if (line.empty()) continue;
     const auto cells = split_commas(line);
-
-    if (!have_header) {
-      have_header = true;
+    if (!index) {
       columns = cells.size();
-      for (std::size_t c = 0; c < cells.size(); ++c) {
-        const auto it = std::find(kColumnNames.begin(), kColumnNames.end(), cells[c]);
-        if (it == kColumnNames.end()) {
-          fail(line_no, "unknown column '" + std::string(cells[c]) +
-                            "' (the columns are file,x,y,z,yaw_deg and optionally "
-                            "roll_deg,pitch_deg)");
-        }
-        const auto col = static_cast<std::size_t>(it - kColumnNames.begin());
-        if (index[col] >= 0) fail(line_no, "column '" + std::string(cells[c]) + "' appears twice");
-        index[col] = static_cast<int>(c);
-      }
-      for (std::size_t col = kFile; col <= kYaw; ++col) {
-        if (index[col] < 0) {
-          fail(line_no, "the header has no '" + std::string(kColumnNames[col]) +
-                            "' column (it needs file,x,y,z,yaw_deg)");
-        }
-      }
+      index = header_columns(cells, fail);
       continue;
     }
-
     if (cells.size() != columns) {
-      fail(line_no, std::to_string(cells.size()) + " values but the header has " +
-                        std::to_string(columns) + " columns");
+      fail(std::to_string(cells.size()) + " values but the header has " + std::to_string(columns) +
+           " columns");
     }
-    std::array<double, kColumnCount> v{};
-    for (std::size_t col = kX; col < kColumnCount; ++col) {
-      if (index[col] < 0) continue;
-      const std::string_view cell = cells[static_cast<std::size_t>(index[col])];
-      if (!parse_double(cell, v[col])) {
-        fail(line_no, "column '" + std::string(kColumnNames[col]) + "': '" +
-                          std::string(cell.substr(0, 40)) + "' is not a finite number");
-      }
-    }
-    const std::string_view name = cells[static_cast<std::size_t>(index[kFile])];
-    if (name.empty()) fail(line_no, "the 'file' column is empty");
-    const fs::path rel(name);
-    const std::string ext = lower(rel.extension().string());
-    if (ext != ".ply" && ext != ".pcd") {
-      fail(line_no, "scan file '" + std::string(name) + "' is not .ply or .pcd");
-    }
-    Entry e;
-    e.scan = rel.is_absolute() ? rel : dir_ / rel;
-    std::error_code ec;
-    if (!fs::is_regular_file(e.scan, ec)) {
-      fail(line_no, "scan file '" + std::string(name) + "' does not exist in " + dir_.string());
-    }
-    e.pose.x = v[kX];
-    e.pose.y = v[kY];
-    e.pose.z = v[kZ];
-    e.pose.yaw = deg2rad(v[kYaw]);
-    e.pose.roll = deg2rad(v[kRoll]);
-    e.pose.pitch = deg2rad(v[kPitch]);
+    Entry e = entry_of(cells, *index, dir_, fail);
     e.image = image_beside(e.scan);
     entries_.push_back(std::move(e));
   }
-  if (!have_header) throw ReplayFolderError(csv.string() + ": is empty (it needs a header line)");
+  if (!index) throw ReplayFolderError(csv.string() + ": is empty (it needs a header line)");
   if (entries_.empty()) throw ReplayFolderError(csv.string() + ": lists no scans");
 }
 

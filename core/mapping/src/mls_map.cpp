@@ -170,7 +170,7 @@ void MlsMap::fill_between(const Eigen::Vector3f& a, const Eigen::Vector3f& b, Ti
   // Half-cell steps visit every cell the segment crosses.
   const int steps = static_cast<int>(std::ceil(length / (0.5 * config_.cell_m)));
   for (int k = 1; k < steps; ++k) {
-    const Eigen::Vector3f p = a + (b - a) * (static_cast<float>(k) / steps);
+    const Eigen::Vector3f p = a + (b - a) * (static_cast<float>(k) / static_cast<float>(steps));
     const CellIndex c = index_of(p.x(), p.y());
     // Only cells the laser saw nothing in: measured surfaces keep their own statistics.
     const MlsCell* existing = cell(c);

@@ -79,7 +79,8 @@ cv::Mat render_elevation(const MlsMap& map, const RegionMap& regions, const TopV
   cv::Mat level = paint(regions, style, [&](CellIndex c, Region r) {
     const MlsCell* cell = r == Region::kOutside ? nullptr : map.cell(c);
     // Level 0 is kept for "no data"; heights use 1..255.
-    const int v = cell ? 1 + static_cast<int>(254.0f * (cell->dem_height() - lo) / span) : 0;
+    const auto v = static_cast<std::uint8_t>(
+        cell ? 1 + static_cast<int>(254.0f * (cell->dem_height() - lo) / span) : 0);
     return cv::Vec3b(v, v, v);
   });
   cv::Mat gray, colored;

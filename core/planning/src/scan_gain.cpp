@@ -46,9 +46,9 @@ ScanGain ScanGainEvaluator::at(CellIndex b, double floor_z,
     }
   }
   ScanGain g;
-  g.unscanned_m2 = unscanned * regions_.cell_area_m2();
-  g.low_resolution_m2 = low_resolution * regions_.cell_area_m2();
-  g.completed_m2 = (unscanned_near + low_resolution) * regions_.cell_area_m2();
+  g.unscanned_m2 = static_cast<double>(unscanned) * regions_.cell_area_m2();
+  g.low_resolution_m2 = static_cast<double>(low_resolution) * regions_.cell_area_m2();
+  g.completed_m2 = static_cast<double>(unscanned_near + low_resolution) * regions_.cell_area_m2();
   g.f = alpha_ * g.unscanned_m2 + (1 - alpha_) * g.low_resolution_m2;
   return g;
 }

@@ -251,119 +251,143 @@ std::vector<std::int32_t> lattice_sites(const Sites& sites, double lattice_m, do
   return which;
 }
 
-// Paper §3.4: hill climbing on F (or another score) from several random starts. Each climb
-// moves to its best 8-neighbour at the current move length while the score improves, then
-// halves the move; climbs run in parallel, each with its own memory of evaluated cells, so
-// the result and the count of evaluations are the same whatever the thread count.
+// Where hill climbing starts, the sites already evaluated to choose them, and the score it
+// climbs (its scale set by the best F seen so far).
+struct ClimbStarts {
+  std::vector<std::int32_t> sites;
+  std::vector<Scored> screened;
+  Scorer score;
+  std::size_t evaluations = 0;  // of the starts themselves, outside `screened`
+};
+
+// The starts are the best of a random sample rather than the sample's first few: the same
+// randomised initial locations, but the climbs begin on the hills worth climbing. The sample is
+// a lattice at a random offset, about hill_climb_samples cells on the movable region: random
+// like the paper's starts, but spread evenly, so no part of the region is left without a start
+// nearby.
+ClimbStarts screened_starts(const ScanGainEvaluator& gain, const Sites& sites,
+                            const PlannerConfig& cfg, int threads, const ScorerFor& scorer_for,
+                            SplitMix& rng) {
+  ClimbStarts out;
+  const int stride = std::max(1, static_cast<int>(std::lround(std::sqrt(
+                                     static_cast<double>(sites.size()) / cfg.hill_climb_samples))));
+  const int ox = static_cast<int>(rng.below(static_cast<std::size_t>(stride)));
+  const int oy = static_cast<int>(rng.below(static_cast<std::size_t>(stride)));
+  std::vector<std::int32_t> sample;
+  for (std::size_t s = 0; s < sites.size(); ++s) {
+    if (floor_mod(sites.cell[s].x - ox, stride) == 0 &&
+        floor_mod(sites.cell[s].y - oy, stride) == 0) {
+      sample.push_back(static_cast<std::int32_t>(s));
+    }
+  }
+  // A region thinner than the lattice still gets a start.
+  if (sample.empty()) sample.push_back(static_cast<std::int32_t>(rng.below(sites.size())));
+  out.screened = evaluate_sites(gain, sites, sample, threads);
+  double best_f = 0;
+  for (const Scored& x : out.screened) best_f = std::max(best_f, x.gain.f);
+  out.score = scorer_for(best_f);
+  for (Scored& x : out.screened) x.score = out.score(x.site, x.gain);
+  std::vector<Scored> order = out.screened;
+  std::stable_sort(order.begin(), order.end(),
+                   [](const Scored& a, const Scored& b) { return a.score > b.score; });
+  for (std::size_t k = 0;
+       k < order.size() && static_cast<int>(out.sites.size()) < cfg.hill_climb_starts; ++k) {
+    out.sites.push_back(order[k].site);
+  }
+  return out;
+}
+
+// The paper's own starts: random cells of the movable region, with no first look.
+ClimbStarts random_starts(const ScanGainEvaluator& gain, const Sites& sites,
+                          const PlannerConfig& cfg, const ScorerFor& scorer_for, SplitMix& rng) {
+  ClimbStarts out;
+  for (int k = 0; k < cfg.hill_climb_starts; ++k)
+    out.sites.push_back(static_cast<std::int32_t>(rng.below(sites.size())));
+  // The best F is that of the starts.
+  double best_f = 0;
+  for (const std::int32_t s : out.sites) {
+    const auto u = static_cast<std::size_t>(s);
+    best_f = std::max(best_f, gain.at(sites.cell[u], sites.floor_z[u]).f);
+  }
+  out.evaluations = out.sites.size();
+  out.score = scorer_for(best_f);
+  return out;
+}
+
+// One climb from `start`: to the best 8-neighbour at the current move length while the score
+// improves, then at half the move. Returns every site it evaluated, in order.
+std::vector<Scored> climb(const ScanGainEvaluator& gain, const Sites& sites, std::int32_t start,
+                          int first_stride, const Scorer& score,
+                          VisibilityPredictor::Workspace& ws) {
+  static constexpr int kDx[8] = {1, 1, 0, -1, -1, -1, 0, 1};
+  static constexpr int kDy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+  std::unordered_map<std::int32_t, double> memo;
+  std::vector<Scored> seen;
+  const auto value_at = [&](std::int32_t s) {
+    const auto it = memo.find(s);
+    if (it != memo.end()) return it->second;
+    const auto u = static_cast<std::size_t>(s);
+    const ScanGain g = gain.at(sites.cell[u], sites.floor_z[u], ws);
+    const double v = score(s, g);
+    memo.emplace(s, v);
+    seen.push_back({s, g, v});
+    return v;
+  };
+  std::int32_t at = start;
+  double value = value_at(at);
+  for (int stride = first_stride; stride >= 1; stride /= 2) {
+    for (;;) {
+      std::int32_t best = -1;
+      double best_value = value;
+      const CellIndex c = sites.cell[static_cast<std::size_t>(at)];
+      for (int n = 0; n < 8; ++n) {
+        const std::int32_t s = sites.at({c.x + stride * kDx[n], c.y + stride * kDy[n]});
+        if (s < 0) continue;
+        const double v = value_at(s);
+        if (v > best_value) {
+          best_value = v;
+          best = s;
+        }
+      }
+      if (best < 0) break;
+      at = best;
+      value = best_value;
+    }
+  }
+  return seen;
+}
+
+// Paper §3.4: hill climbing on F (or another score) from several random starts. Climbs run in
+// parallel, each with its own memory of evaluated cells, so the result and the count of
+// evaluations are the same whatever the thread count.
 std::vector<Scored> hill_climb(const ScanGainEvaluator& gain, const Sites& sites,
                                const PlannerConfig& cfg, double cell_m, int threads,
                                const ScorerFor& scorer_for, std::size_t& evaluations) {
   SplitMix rng(cfg.seed);
-  std::vector<std::int32_t> starts;
-  std::vector<Scored> screened;
-  Scorer score;
-  std::size_t evaluations_before = 0;
-  if (cfg.hill_climb_samples > 0) {
-    // The starts are the best of a random sample rather than the sample's first few: the
-    // same randomised initial locations, but the climbs begin on the hills worth climbing.
-    // The sample is a lattice at a random offset, about hill_climb_samples cells on the
-    // movable region: random like the paper's starts, but spread evenly, so no part of the
-    // region is left without a start nearby.
-    const int stride = std::max(
-        1, static_cast<int>(
-               std::lround(std::sqrt(static_cast<double>(sites.size()) / cfg.hill_climb_samples))));
-    const int ox = static_cast<int>(rng.below(static_cast<std::size_t>(stride)));
-    const int oy = static_cast<int>(rng.below(static_cast<std::size_t>(stride)));
-    std::vector<std::int32_t> sample;
-    for (std::size_t s = 0; s < sites.size(); ++s) {
-      if (floor_mod(sites.cell[s].x - ox, stride) == 0 &&
-          floor_mod(sites.cell[s].y - oy, stride) == 0) {
-        sample.push_back(static_cast<std::int32_t>(s));
-      }
-    }
-    // A region thinner than the lattice still gets a start.
-    if (sample.empty()) sample.push_back(static_cast<std::int32_t>(rng.below(sites.size())));
-    screened = evaluate_sites(gain, sites, sample, threads);
-    double best_f = 0;
-    for (const Scored& x : screened) best_f = std::max(best_f, x.gain.f);
-    score = scorer_for(best_f);
-    for (Scored& x : screened) x.score = score(x.site, x.gain);
-    std::vector<Scored> order = screened;
-    std::stable_sort(order.begin(), order.end(),
-                     [](const Scored& a, const Scored& b) { return a.score > b.score; });
-    for (std::size_t k = 0;
-         k < order.size() && static_cast<int>(starts.size()) < cfg.hill_climb_starts; ++k) {
-      starts.push_back(order[k].site);
-    }
-  } else {
-    for (int k = 0; k < cfg.hill_climb_starts; ++k)
-      starts.push_back(static_cast<std::int32_t>(rng.below(sites.size())));
-    // No first look: the best F is that of the starts.
-    double best_f = 0;
-    for (const std::int32_t s : starts) {
-      best_f = std::max(best_f, gain.at(sites.cell[static_cast<std::size_t>(s)],
-                                        sites.floor_z[static_cast<std::size_t>(s)])
-                                    .f);
-    }
-    evaluations_before = starts.size();
-    score = scorer_for(best_f);
-  }
+  const ClimbStarts starts = cfg.hill_climb_samples > 0
+                                 ? screened_starts(gain, sites, cfg, threads, scorer_for, rng)
+                                 : random_starts(gain, sites, cfg, scorer_for, rng);
   const int first_stride =
       std::max(1, static_cast<int>(std::lround(cfg.hill_climb_step_m / cell_m)));
-  static constexpr int kDx[8] = {1, 1, 0, -1, -1, -1, 0, 1};
-  static constexpr int kDy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
-
-  std::vector<std::vector<Scored>> visited(starts.size());
+  std::vector<std::vector<Scored>> visited(starts.sites.size());
 #pragma omp parallel num_threads(threads)
   {
     auto ws = gain.workspace();
 #pragma omp for schedule(dynamic, 1)
-    for (std::size_t k = 0; k < starts.size(); ++k) {
-      std::unordered_map<std::int32_t, double> memo;
-      auto& seen = visited[k];
-      const auto value_at = [&](std::int32_t s) {
-        const auto it = memo.find(s);
-        if (it != memo.end()) return it->second;
-        const auto u = static_cast<std::size_t>(s);
-        const ScanGain g = gain.at(sites.cell[u], sites.floor_z[u], ws);
-        const double v = score(s, g);
-        memo.emplace(s, v);
-        seen.push_back({s, g, v});
-        return v;
-      };
-      std::int32_t at = starts[k];
-      double value = value_at(at);
-      for (int stride = first_stride; stride >= 1; stride /= 2) {
-        for (;;) {
-          std::int32_t best = -1;
-          double best_value = value;
-          const CellIndex c = sites.cell[static_cast<std::size_t>(at)];
-          for (int n = 0; n < 8; ++n) {
-            const std::int32_t s = sites.at({c.x + stride * kDx[n], c.y + stride * kDy[n]});
-            if (s < 0) continue;
-            const double v = value_at(s);
-            if (v > best_value) {
-              best_value = v;
-              best = s;
-            }
-          }
-          if (best < 0) break;
-          at = best;
-          value = best_value;
-        }
-      }
+    for (std::size_t k = 0; k < starts.sites.size(); ++k) {
+      visited[k] = climb(gain, sites, starts.sites[k], first_stride, starts.score, ws);
     }
   }
   std::vector<Scored> all;
   std::vector<bool> taken(sites.size(), false);
-  evaluations = evaluations_before + screened.size();
-  for (const Scored& s : screened) {
+  evaluations = starts.evaluations + starts.screened.size();
+  for (const Scored& s : starts.screened) {
     taken[static_cast<std::size_t>(s.site)] = true;
     all.push_back(s);
   }
-  for (const auto& climb : visited) {
-    evaluations += climb.size();
-    for (const Scored& s : climb) {
+  for (const auto& path : visited) {
+    evaluations += path.size();
+    for (const Scored& s : path) {
       if (taken[static_cast<std::size_t>(s.site)]) continue;
       taken[static_cast<std::size_t>(s.site)] = true;
       all.push_back(s);
@@ -451,6 +475,114 @@ std::optional<Eigen::Vector3d> nearest_floor(const MlsMap& map, const Eigen::Vec
   return std::nullopt;
 }
 
+// The policy's choice among the sites, best first (PlannerConfig::policy).
+std::vector<Scored> choose(const PlannerConfig& cfg, const ScanGainEvaluator& gain,
+                           const Sites& sites, const RegionMap& regions, double cell_m, int threads,
+                           std::size_t& evaluations) {
+  std::vector<Scored> chosen;
+  switch (cfg.policy) {
+    case PlannerPolicy::kPaper: {
+      chosen = rank(hill_climb(gain, sites, cfg, cell_m, threads, gain_only, evaluations), sites,
+                    cfg, cell_m);
+      break;
+    }
+    case PlannerPolicy::kExhaustive: {
+      const double w = cfg.completion_weight;
+      const Scorer with_completion = [w](std::int32_t, const ScanGain& g) {
+        return g.f + w * g.completed_m2;
+      };
+      auto all = evaluate_sites(gain, sites, lattice_sites(sites, cfg.lattice_m, cell_m), threads,
+                                with_completion);
+      evaluations = all.size();
+      chosen = rank(std::move(all), sites, cfg, cell_m);
+      break;
+    }
+    case PlannerPolicy::kTravel: {
+      // A metre of driving beyond travel_free_m costs travel_cost_per_m of the best F in view,
+      // so the trade keeps its balance as the gains shrink over a mission. The drive is smooth
+      // over the region, so the traded score is climbed as F is.
+      const ScorerFor traded = [&](double best_f) -> Scorer {
+        const double per_m = cfg.travel_cost_per_m * best_f;
+        const double free_m = cfg.travel_free_m;
+        return [&sites, per_m, free_m](std::int32_t site, const ScanGain& g) {
+          const double drive = sites.travel_m[static_cast<std::size_t>(site)];
+          return g.f - per_m * std::max(0.0, drive - free_m);
+        };
+      };
+      chosen = rank(hill_climb(gain, sites, cfg, cell_m, threads, traded, evaluations), sites, cfg,
+                    cell_m);
+      break;
+    }
+    case PlannerPolicy::kNearestFrontier: {
+      // Frontiers between the movable region and the unscanned region first (Yamauchi 1997);
+      // once none is left, the low-resolution region's.
+      auto order = frontier_sites(sites, regions, Region::kUnscanned);
+      if (order.empty()) order = frontier_sites(sites, regions, Region::kLowResolution);
+      std::stable_sort(order.begin(), order.end(), [&](std::int32_t a, std::int32_t b) {
+        return sites.travel_m[static_cast<std::size_t>(a)] <
+               sites.travel_m[static_cast<std::size_t>(b)];
+      });
+      chosen = first_worth_scanning(gain, sites, order, cfg, cell_m, threads, evaluations);
+      for (Scored& s : chosen) s.score = -sites.travel_m[static_cast<std::size_t>(s.site)];
+      break;
+    }
+    case PlannerPolicy::kRandom: {
+      SplitMix rng(cfg.seed);
+      std::vector<std::int32_t> order;
+      std::vector<bool> drawn(sites.size(), false);
+      const std::size_t draws = std::min(sites.size(), kMaxBaselineEvaluations);
+      while (order.size() < draws) {
+        const std::size_t s = rng.below(sites.size());
+        if (drawn[s]) continue;
+        drawn[s] = true;
+        order.push_back(static_cast<std::int32_t>(s));
+      }
+      chosen = first_worth_scanning(gain, sites, order, cfg, cell_m, threads, evaluations);
+      break;
+    }
+  }
+
+  return chosen;
+}
+
+// The sites chosen as the operator sees them, with the drive there.
+std::vector<Candidate> to_candidates(const std::vector<Scored>& chosen, const Sites& sites,
+                                     const MlsMap& map, const TravelMap& travel) {
+  std::vector<Candidate> out;
+  for (const Scored& s : chosen) {
+    const auto u = static_cast<std::size_t>(s.site);
+    Candidate c;
+    const Eigen::Vector2d xy = map.center_of(sites.cell[u]);
+    c.position = {xy.x(), xy.y(), sites.floor_z[u]};
+    c.f = s.gain.f;
+    c.gain_unscanned_m2 = s.gain.unscanned_m2;
+    c.gain_low_res_m2 = s.gain.low_resolution_m2;
+    c.gain_completed_m2 = s.gain.completed_m2;
+    c.travel_m = sites.travel_m[u];
+    c.path = travel.path_to(sites.cell[u]);
+    c.score = s.score;
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+// The segmentation and the movable region flooded from the robot; returns where the robot
+// stands (its floor may lie a few cells off the reported position).
+Eigen::Vector3d segment_and_flood(const PlanInput& in, const PlannerConfig& cfg, Plan& plan) {
+  plan.regions = segment_regions(in.map, in.target, in.scan_points, cfg.regions);
+  plan.movable = movable_region(in.map, in.robot, cfg.movable);
+  if (plan.movable.cells > 0) return in.robot;
+  // movable_region looks for the robot's floor within one cell. Gap filling between a ground
+  // return and the foot of a low wall can leave a ramp of interpolated heights there, and once
+  // the robot's own scan adds the real ground those cells are too deep to be floors; the robot
+  // still stands on the ground a few cells away.
+  if (const auto near = nearest_floor(in.map, in.robot, cfg.movable)) {
+    plan.movable = movable_region(in.map, *near, cfg.movable);
+    return *near;
+  }
+  return in.robot;
+}
+
 }  // namespace
 
 Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
@@ -466,19 +598,7 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     return std::move(plan);
   };
-  plan.regions = segment_regions(in.map, in.target, in.scan_points, cfg.regions);
-  plan.movable = movable_region(in.map, in.robot, cfg.movable);
-  Eigen::Vector3d start = in.robot;
-  if (plan.movable.cells == 0) {
-    // movable_region looks for the robot's floor within one cell. Gap filling between a
-    // ground return and the foot of a low wall can leave a ramp of interpolated heights
-    // there, and once the robot's own scan adds the real ground those cells are too deep to
-    // be floors; the robot still stands on the ground a few cells away.
-    if (const auto near = nearest_floor(in.map, in.robot, cfg.movable)) {
-      start = *near;
-      plan.movable = movable_region(in.map, start, cfg.movable);
-    }
-  }
+  const Eigen::Vector3d start = segment_and_flood(in, cfg, plan);
   if (plan.movable.cells == 0 || plan.regions.unscanned + plan.regions.low_resolution == 0)
     return finish();
 
@@ -495,86 +615,9 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
                                cfg.regions, cfg.visibility);
   if (!claims.empty())
     claim_predicted_scans(claimed_regions, gain.predictor(), claims, cfg.regions);
-  const double cell_m = in.map.cell_m();
-  const int threads = thread_count(cfg);
-
-  std::vector<Scored> chosen;
-  switch (cfg.policy) {
-    case PlannerPolicy::kPaper: {
-      chosen = rank(hill_climb(gain, sites, cfg, cell_m, threads, gain_only, plan.evaluations),
-                    sites, cfg, cell_m);
-      break;
-    }
-    case PlannerPolicy::kExhaustive: {
-      const double w = cfg.completion_weight;
-      const Scorer with_completion = [w](std::int32_t, const ScanGain& g) {
-        return g.f + w * g.completed_m2;
-      };
-      auto all = evaluate_sites(gain, sites, lattice_sites(sites, cfg.lattice_m, cell_m), threads,
-                                with_completion);
-      plan.evaluations = all.size();
-      chosen = rank(std::move(all), sites, cfg, cell_m);
-      break;
-    }
-    case PlannerPolicy::kTravel: {
-      // A metre of driving beyond travel_free_m costs travel_cost_per_m of the best F in view,
-      // so the trade keeps its balance as the gains shrink over a mission. The drive is smooth
-      // over the region, so the traded score is climbed as F is.
-      const ScorerFor traded = [&](double best_f) -> Scorer {
-        const double per_m = cfg.travel_cost_per_m * best_f;
-        const double free_m = cfg.travel_free_m;
-        return [&sites, per_m, free_m](std::int32_t site, const ScanGain& g) {
-          const double drive = sites.travel_m[static_cast<std::size_t>(site)];
-          return g.f - per_m * std::max(0.0, drive - free_m);
-        };
-      };
-      chosen = rank(hill_climb(gain, sites, cfg, cell_m, threads, traded, plan.evaluations), sites,
-                    cfg, cell_m);
-      break;
-    }
-    case PlannerPolicy::kNearestFrontier: {
-      // Frontiers between the movable region and the unscanned region first (Yamauchi 1997);
-      // once none is left, the low-resolution region's.
-      auto order = frontier_sites(sites, plan.regions, Region::kUnscanned);
-      if (order.empty()) order = frontier_sites(sites, plan.regions, Region::kLowResolution);
-      std::stable_sort(order.begin(), order.end(), [&](std::int32_t a, std::int32_t b) {
-        return sites.travel_m[static_cast<std::size_t>(a)] <
-               sites.travel_m[static_cast<std::size_t>(b)];
-      });
-      chosen = first_worth_scanning(gain, sites, order, cfg, cell_m, threads, plan.evaluations);
-      for (Scored& s : chosen) s.score = -sites.travel_m[static_cast<std::size_t>(s.site)];
-      break;
-    }
-    case PlannerPolicy::kRandom: {
-      SplitMix rng(cfg.seed);
-      std::vector<std::int32_t> order;
-      std::vector<bool> drawn(sites.size(), false);
-      const std::size_t draws = std::min(sites.size(), kMaxBaselineEvaluations);
-      while (order.size() < draws) {
-        const std::size_t s = rng.below(sites.size());
-        if (drawn[s]) continue;
-        drawn[s] = true;
-        order.push_back(static_cast<std::int32_t>(s));
-      }
-      chosen = first_worth_scanning(gain, sites, order, cfg, cell_m, threads, plan.evaluations);
-      break;
-    }
-  }
-
-  for (const Scored& s : chosen) {
-    const auto u = static_cast<std::size_t>(s.site);
-    Candidate c;
-    const Eigen::Vector2d xy = in.map.center_of(sites.cell[u]);
-    c.position = {xy.x(), xy.y(), sites.floor_z[u]};
-    c.f = s.gain.f;
-    c.gain_unscanned_m2 = s.gain.unscanned_m2;
-    c.gain_low_res_m2 = s.gain.low_resolution_m2;
-    c.gain_completed_m2 = s.gain.completed_m2;
-    c.travel_m = sites.travel_m[u];
-    c.path = travel.path_to(sites.cell[u]);
-    c.score = s.score;
-    plan.ranked.push_back(std::move(c));
-  }
+  const std::vector<Scored> chosen =
+      choose(cfg, gain, sites, plan.regions, in.map.cell_m(), thread_count(cfg), plan.evaluations);
+  plan.ranked = to_candidates(chosen, sites, in.map, travel);
   return finish();
 }
 

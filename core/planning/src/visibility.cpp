@@ -104,7 +104,14 @@ VisibilityPredictor::VisibilityPredictor(const MlsMap& map, CellIndex raster_ori
     sensor_max_ = {std::max(sensor_max_.x, extent->second.x),
                    std::max(sensor_max_.y, extent->second.y)};
   }
-  const int pad = static_cast<int>(std::ceil(config.max_range_m / cell_m_)) + 2;
+  build_dense(map);
+  sensor_offset_ = sensor_offset;
+  if (config.thin_object_radius_m > 0) find_thin_objects();
+  build_rays(sensor_offset);
+}
+
+void VisibilityPredictor::build_dense(const MlsMap& map) {
+  const int pad = static_cast<int>(std::ceil(config_.max_range_m / cell_m_)) + 2;
   dense_origin_ = {sensor_min_.x - pad, sensor_min_.y - pad};
   dense_cols_ = sensor_max_.x - sensor_min_.x + 1 + 2 * pad;
   dense_rows_ = sensor_max_.y - sensor_min_.y + 1 + 2 * pad;
@@ -126,9 +133,10 @@ VisibilityPredictor::VisibilityPredictor(const MlsMap& map, CellIndex raster_ori
     }
     max_z_ = std::max(max_z_, d.top);
   });
-  sensor_offset_ = sensor_offset;
-  if (config.thin_object_radius_m > 0) find_thin_objects();
+}
 
+void VisibilityPredictor::build_rays(const Eigen::Vector2d& sensor_offset) {
+  const VisibilityConfig& config = config_;
   // The ray tree. Rays 2^l azimuth steps apart are max_ray_spacing_m apart at reach(l);
   // level l covers the distances from reach(l + 1) to reach(l), the finest level everything
   // beyond. A level-l ray stands for the 2^l finest azimuths of its sector and sits at their
@@ -295,22 +303,22 @@ void VisibilityPredictor::mark(const Trace& t, const Step& s, Workspace& ws) con
   ws.visible.push_back(static_cast<std::uint32_t>(o));
 }
 
-void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
-                                Workspace& ws) const {
-  const Ray& ray =
-      rays_[level_offset_[static_cast<std::size_t>(level)] + static_cast<std::size_t>(m)];
-  Trace t = tr;
-  t.dir = ray.dir;
-  t.half_spacing = static_cast<float>(0.5 * 2 * M_PI / azimuths_ * (1 << level));
-  const float* slope = slope_.data();
-  const float* inv_slope = inv_slope_.data();
-  const float sz = t.sz;
-  const Step* walk = steps_.data() + ray.walk_begin;
-  const Step* begin = steps_.data() + ray.segment_begin;
-  const Step* end = steps_.data() + ray.walk_end;
+// One ray's walk outward through the cells (trace), step by step: which free beams each cell's
+// surfaces stop, the returns they leave, and the ground filled between them. The parts are
+// forced inline: this is the planner's innermost loop (docs/benchmarks.md planner_campus).
+struct VisibilityPredictor::Tracer {
+  const VisibilityPredictor& vp;
+  const Trace& t;
+  RayState& st;
+  Workspace& ws;
+  const float* slope;
+  const float* inv_slope;
+  const Step* walk;  // the ray's first step, at the sensor
+  float sz;
 
   // Where beam k, known to cross the patch [lo, hi] of the cell entered at d0, first meets it.
-  const auto landing = [&](int k, float d0, float lo, float hi, float& d, float& z) {
+  [[gnu::always_inline]] void landing(int k, float d0, float lo, float hi, float& d,
+                                      float& z) const {
     const float tk = slope[k];
     const float z0 = sz + tk * d0;
     if (tk < 0 && z0 > hi) {  // comes down onto the top
@@ -323,23 +331,25 @@ void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
       d = d0;
       z = z0;
     }
-  };
-  const auto in_range = [&](float d, float z) {
+  }
+
+  [[gnu::always_inline]] bool in_range(float d, float z) const {
     const float r2 = d * d + (z - sz) * (z - sz);
     return r2 >= t.min_r2 && r2 <= t.max_r2;
-  };
+  }
+
   // insert_scan's rule for filling between two neighbouring returns of a fan: both below the
   // laser and off its axis, no closer than a cell and no farther than fill_max_gap_m, gently
   // sloped. Returns come here in distance order, which for descending beams is beam order.
-  const auto chain = [&](const Step* s, float d0, float z0, float d1, float z1) {
+  [[gnu::always_inline]] void chain(const Step* s, float d0, float z0, float d1, float z1) {
     const bool usable = z0 < sz && d0 > 0.3f;
-    if (fill_ && st.have_last && st.last_usable && usable && d0 > st.last_d) {
+    if (vp.fill_ && st.have_last && st.last_usable && usable && d0 > st.last_d) {
       const float length = d0 - st.last_d;
-      if (length >= t.min_fill && length <= fill_max_gap_ &&
-          std::abs(z0 - st.last_z) <= fill_max_slope_ * length) {
+      if (length >= t.min_fill && length <= vp.fill_max_gap_ &&
+          std::abs(z0 - st.last_z) <= vp.fill_max_slope_ * length) {
         for (const Step* p = s - 1; p >= walk && p->d0 >= st.last_d; --p) {
           // A corner the walk only clips is usually missed by the fill's half-cell samples.
-          if (p->d1 - p->d0 >= t.min_clip) mark(t, *p, ws);
+          if (p->d1 - p->d0 >= t.min_clip) vp.mark(t, *p, ws);
         }
       }
     }
@@ -347,41 +357,21 @@ void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
     st.last_usable = z1 < sz && d1 > 0.3f;
     st.last_d = d1;
     st.last_z = z1;
-  };
+  }
 
-  for (const Step* s = begin; s != end; ++s) {
-    // Every beam still free passes above the highest surface anywhere: nothing more to see.
-    if (slope[st.k_min] > 0 && slope[st.k_min] * s->d0 > t.ceiling) {
-      st.done = true;
-      return;
-    }
-    const std::size_t at = t.base + static_cast<std::ptrdiff_t>(s->dense_delta);
-    const DenseCell& cell = dense_[at];
-    // Below the lowest surface of a cell the ground is solid (the measured top of a cell is a
-    // few centimetres off its neighbour's, and a beam passing under it would slip beneath the
-    // ground), unless that lowest one hangs well above the ground carried along the ray: then
-    // it is a canopy or an overhang whose ground was not seen, assumed as for unknown cells.
-    const bool hanging = cell.n > 0 && cell.lo0 > st.ground + t.ground_jump;
-    const bool assume = cell.n == 0 || hanging;
-    if (assume && !config_.unknown_as_ground && cell.n == 0) continue;
-    if (!assume && cell.hi0 - cell.lo0 <= t.ground_extent &&
-        std::abs(cell.hi0 - st.ground) <= t.ground_jump) {
-      st.ground = cell.hi0;
-    }
-    // Most cells lie wholly below the lowest free beam (ground already passed over).
-    const float r_top = (cell.n == 0 ? st.ground : cell.top) - sz;
-    if ((r_top > 0 ? r_top * s->inv_d0 : r_top * s->inv_d1) < slope[st.k_min]) continue;
-    // The surfaces that stop beams here.
-    float lo_hi[2 * (MlsCell::kMaxPatches + 1)];
+  // The surfaces of the cell entered at `s` that stop beams, as [lo, hi] pairs into `lo_hi`;
+  // returns how many.
+  [[gnu::always_inline]] int surfaces(const Step& s, std::size_t at, const DenseCell& cell,
+                                      bool assume, bool hanging, float* lo_hi) const {
     int n = 0;
-    if (assume && config_.unknown_as_ground) {
+    if (assume && vp.config_.unknown_as_ground) {
       lo_hi[0] = -kSolid;
       lo_hi[1] = st.ground;
       n = 1;
     }
     for (int p = 0; p < cell.n; ++p) {
-      lo_hi[2 * n] = patches_[at][2 * p];
-      lo_hi[2 * n + 1] = patches_[at][2 * p + 1];
+      lo_hi[2 * n] = vp.patches_[at][2 * p];
+      lo_hi[2 * n + 1] = vp.patches_[at][2 * p + 1];
       ++n;
     }
     if (!hanging) {
@@ -389,14 +379,120 @@ void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
       // A ray passing beside a thin object meets only the ground at its foot.
       if (cell.thin >= 0) {
         const Eigen::Vector2f rel =
-            thin_centres_[static_cast<std::size_t>(cell.thin)] - t.sensor_xy;
+            vp.thin_centres_[static_cast<std::size_t>(cell.thin)] - t.sensor_xy;
         // At least half the gap to the neighbouring rays, or an object between two rays
         // would stop neither.
-        const float radius = std::max(t.thin_radius, s->d0 * t.half_spacing);
+        const float radius = std::max(t.thin_radius, s.d0 * t.half_spacing);
         if (std::abs(rel.x() * t.dir.y() - rel.y() * t.dir.x()) > radius) lo_hi[1] = cell.lo0;
       }
     }
-    bool seen = false, stopped = false;
+    return n;
+  }
+
+  // The free beams whose slopes lie in [t_lo, t_hi], as k0..k1; false when there are none.
+  // Ground takes the lowest free beam and a few above it, found by walking the slope table;
+  // atan only for tall spans.
+  [[gnu::always_inline]] bool beams_between(float t_lo, float t_hi, int& k0, int& k1) const {
+    k0 = st.k_min;
+    if (t_lo > slope[k0]) {
+      k0 = std::max(st.k_min,
+                    static_cast<int>(std::ceil((fast_atan(t_lo) - vp.el0_) * vp.inv_el_step_)));
+      while (k0 > st.k_min && slope[k0 - 1] >= t_lo) --k0;
+      while (k0 <= st.k_max && slope[k0] < t_lo) ++k0;
+      if (k0 > st.k_max) return false;
+    }
+    k1 = st.k_max;
+    if (t_hi < slope[k1]) {
+      k1 = k0 - 1;
+      int walked = 0;
+      while (walked < 8 && slope[k1 + 1] <= t_hi) {
+        ++k1;
+        ++walked;
+      }
+      if (walked == 8) {
+        k1 = std::min(st.k_max,
+                      static_cast<int>(std::floor((fast_atan(t_hi) - vp.el0_) * vp.inv_el_step_)));
+        while (k1 < st.k_max && slope[k1 + 1] <= t_hi) ++k1;
+        while (k1 >= k0 && slope[k1] > t_hi) --k1;
+      }
+    }
+    return k0 <= k1;
+  }
+
+  struct Stops {
+    bool seen = false;     // a return in range: the cell is seen
+    bool stopped = false;  // some free beam ended here
+  };
+
+  // Ends the still-free beams among k0..k1 at the patch [lo, hi] of the cell entered at `s`.
+  [[gnu::always_inline]] void stop_beams(const Step* s, float lo, float hi, int k0, int k1,
+                                         Stops& out) {
+    const int w0 = k0 >> 6, w1 = k1 >> 6;
+    for (int w = w0; w <= w1; ++w) {
+      std::uint64_t bits = st.free[w];
+      if (w == w0) bits &= ~0ull << (k0 & 63);
+      if (w == w1 && (k1 & 63) != 63) bits &= (1ull << ((k1 & 63) + 1)) - 1;
+      if (!bits) continue;
+      st.free[w] &= ~bits;
+      out.stopped = true;
+      // Each run of still-free beams ends here; the beams it stops leave no return beyond.
+      while (bits) {
+        const int b = std::countr_zero(bits);
+        const std::uint64_t shifted = bits >> b;
+        const int len = ~shifted == 0 ? 64 - b : std::countr_zero(~shifted);
+        const int kf = 64 * w + b, kl = kf + len - 1;
+        bits = b + len >= 64 ? 0 : bits & (~0ull << (b + len));
+        float df, zf, dl, zl;
+        landing(kf, s->d0, lo, hi, df, zf);
+        landing(kl, s->d0, lo, hi, dl, zl);
+        if (!in_range(df, zf) && !in_range(dl, zl)) continue;  // no return: no point
+        out.seen = true;
+        if (zf < sz) chain(s, df, zf, dl, zl);
+      }
+    }
+  }
+
+  // The lowest and highest free beams after some stopped; false when every beam has ended.
+  [[gnu::always_inline]] bool narrow() {
+    const auto is_free = [&](int k) { return (st.free[k >> 6] >> (k & 63)) & 1; };
+    if (!is_free(st.k_min)) {
+      int w = st.k_min >> 6;
+      const int words = (vp.beams_ + 63) >> 6;
+      while (w < words && st.free[w] == 0) ++w;
+      if (w == words) return false;
+      st.k_min = 64 * w + std::countr_zero(st.free[w]);
+    }
+    if (!is_free(st.k_max)) {
+      int w = st.k_max >> 6;
+      while (st.free[w] == 0) --w;
+      st.k_max = 64 * w + 63 - std::countl_zero(st.free[w]);
+    }
+    return true;
+  }
+
+  // The cell entered at `s`; false when nothing more can be seen along this ray.
+  [[gnu::always_inline]] bool step(const Step* s) {
+    // Every beam still free passes above the highest surface anywhere: nothing more to see.
+    if (slope[st.k_min] > 0 && slope[st.k_min] * s->d0 > t.ceiling) return false;
+    const std::size_t at = t.base + static_cast<std::size_t>(s->dense_delta);
+    const DenseCell& cell = vp.dense_[at];
+    // Below the lowest surface of a cell the ground is solid (the measured top of a cell is a
+    // few centimetres off its neighbour's, and a beam passing under it would slip beneath the
+    // ground), unless that lowest one hangs well above the ground carried along the ray: then
+    // it is a canopy or an overhang whose ground was not seen, assumed as for unknown cells.
+    const bool hanging = cell.n > 0 && cell.lo0 > st.ground + t.ground_jump;
+    const bool assume = cell.n == 0 || hanging;
+    if (assume && !vp.config_.unknown_as_ground && cell.n == 0) return true;
+    if (!assume && cell.hi0 - cell.lo0 <= t.ground_extent &&
+        std::abs(cell.hi0 - st.ground) <= t.ground_jump) {
+      st.ground = cell.hi0;
+    }
+    // Most cells lie wholly below the lowest free beam (ground already passed over).
+    const float r_top = (cell.n == 0 ? st.ground : cell.top) - sz;
+    if ((r_top > 0 ? r_top * s->inv_d0 : r_top * s->inv_d1) < slope[st.k_min]) return true;
+    float lo_hi[2 * (MlsCell::kMaxPatches + 1)];
+    const int n = surfaces(*s, at, cell, assume, hanging, lo_hi);
+    Stops stops;
     for (int p = 0; p < n; ++p) {
       const float lo = lo_hi[2 * p], hi = lo_hi[2 * p + 1];
       // The beams crossing the box [d0, d1] × [lo, hi]: slopes between its extreme corners.
@@ -404,73 +500,28 @@ void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
       const float t_lo = rlo < 0 ? rlo * s->inv_d0 : rlo * s->inv_d1;
       const float t_hi = rhi > 0 ? rhi * s->inv_d0 : rhi * s->inv_d1;
       if (t_hi < slope[st.k_min] || t_lo > slope[st.k_max]) continue;
-      // The free beams with t_lo <= slope <= t_hi. Ground takes the lowest free beam and a few
-      // above it, found by walking the slope table; atan only for tall spans.
-      int k0 = st.k_min;
-      if (t_lo > slope[k0]) {
-        k0 = std::max(st.k_min,
-                      static_cast<int>(std::ceil((fast_atan(t_lo) - el0_) * inv_el_step_)));
-        while (k0 > st.k_min && slope[k0 - 1] >= t_lo) --k0;
-        while (k0 <= st.k_max && slope[k0] < t_lo) ++k0;
-        if (k0 > st.k_max) continue;
-      }
-      int k1 = st.k_max;
-      if (t_hi < slope[k1]) {
-        k1 = k0 - 1;
-        int walked = 0;
-        while (walked < 8 && slope[k1 + 1] <= t_hi) {
-          ++k1;
-          ++walked;
-        }
-        if (walked == 8) {
-          k1 = std::min(st.k_max,
-                        static_cast<int>(std::floor((fast_atan(t_hi) - el0_) * inv_el_step_)));
-          while (k1 < st.k_max && slope[k1 + 1] <= t_hi) ++k1;
-          while (k1 >= k0 && slope[k1] > t_hi) --k1;
-        }
-      }
-      if (k0 > k1) continue;
-      const int w0 = k0 >> 6, w1 = k1 >> 6;
-      for (int w = w0; w <= w1; ++w) {
-        std::uint64_t m = st.free[w];
-        if (w == w0) m &= ~0ull << (k0 & 63);
-        if (w == w1 && (k1 & 63) != 63) m &= (1ull << ((k1 & 63) + 1)) - 1;
-        if (!m) continue;
-        st.free[w] &= ~m;
-        stopped = true;
-        // Each run of still-free beams ends here; the beams it stops leave no return beyond.
-        while (m) {
-          const int b = std::countr_zero(m);
-          const std::uint64_t shifted = m >> b;
-          const int len = ~shifted == 0 ? 64 - b : std::countr_zero(~shifted);
-          const int kf = 64 * w + b, kl = kf + len - 1;
-          m = b + len >= 64 ? 0 : m & (~0ull << (b + len));
-          float df, zf, dl, zl;
-          landing(kf, s->d0, lo, hi, df, zf);
-          landing(kl, s->d0, lo, hi, dl, zl);
-          if (!in_range(df, zf) && !in_range(dl, zl)) continue;  // no return: no point
-          seen = true;
-          if (zf < sz) chain(s, df, zf, dl, zl);
-        }
-      }
+      int k0, k1;
+      if (beams_between(t_lo, t_hi, k0, k1)) stop_beams(s, lo, hi, k0, k1, stops);
     }
-    if (seen) mark(t, *s, ws);
-    if (!stopped) continue;
-    const auto is_free = [&](int k) { return (st.free[k >> 6] >> (k & 63)) & 1; };
-    if (!is_free(st.k_min)) {
-      int w = st.k_min >> 6;
-      const int words = (beams_ + 63) >> 6;
-      while (w < words && st.free[w] == 0) ++w;
-      if (w == words) {  // every beam has ended
-        st.done = true;
-        return;
-      }
-      st.k_min = 64 * w + std::countr_zero(st.free[w]);
-    }
-    if (!is_free(st.k_max)) {
-      int w = st.k_max >> 6;
-      while (st.free[w] == 0) --w;
-      st.k_max = 64 * w + 63 - std::countl_zero(st.free[w]);
+    if (stops.seen) vp.mark(t, *s, ws);
+    return !stops.stopped || narrow();
+  }
+};
+
+void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
+                                Workspace& ws) const {
+  const Ray& ray =
+      rays_[level_offset_[static_cast<std::size_t>(level)] + static_cast<std::size_t>(m)];
+  Trace t = tr;
+  t.dir = ray.dir;
+  t.half_spacing = static_cast<float>(0.5 * 2 * M_PI / azimuths_ * (1 << level));
+  Tracer walker{*this, t, st, ws, slope_.data(), inv_slope_.data(), steps_.data() + ray.walk_begin,
+                t.sz};
+  const Step* end = steps_.data() + ray.walk_end;
+  for (const Step* s = steps_.data() + ray.segment_begin; s != end; ++s) {
+    if (!walker.step(s)) {
+      st.done = true;
+      return;
     }
   }
   if (level == 0) return;

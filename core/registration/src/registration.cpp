@@ -71,7 +71,8 @@ double scene_range_m(const PointCloud& cloud) {
     if (p.allFinite()) ranges.push_back(p.norm());
   }
   if (ranges.empty()) return 0;
-  const auto at = ranges.begin() + static_cast<std::ptrdiff_t>(0.9 * (ranges.size() - 1));
+  const auto at =
+      ranges.begin() + static_cast<std::ptrdiff_t>(0.9 * static_cast<double>(ranges.size() - 1));
   std::nth_element(ranges.begin(), at, ranges.end());
   return *at;
 }

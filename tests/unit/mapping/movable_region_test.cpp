@@ -14,7 +14,8 @@ TEST(MovableRegion, StepIsNotCrossedButARampIs) {
   map.insert(slab(0, 10, 0, 10, 0.0f));  // lower ground
   map.insert(slab(10, 20, 0, 5, 0.2f));  // a 0.2 m step up along x
   // A ramp from 0 to 0.2 m over x 10..13 along y 5..10 (0.067 m per cell), then the plaza.
-  for (int x = 10; x < 13; ++x) map.insert(slab(x, x + 1, 5, 10, 0.2f * (x - 9) / 3.0f));
+  for (int x = 10; x < 13; ++x)
+    map.insert(slab(x, x + 1, 5, 10, 0.2f * static_cast<float>(x - 9) / 3.0f));
   map.insert(slab(13, 20, 5, 10, 0.2f));
   const MovableRegion m = movable_region(map, {2.5, 2.5, 0.0});
   EXPECT_TRUE(m.contains({5, 5}));

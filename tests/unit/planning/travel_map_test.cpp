@@ -4,18 +4,12 @@
 
 #include <cmath>
 
+#include "mapping/mapping_test_support.hpp"
+
 namespace scanplan {
 namespace {
 
-std::vector<Eigen::Vector3f> slab(int x0, int x1, int y0, int y1, float z) {
-  std::vector<Eigen::Vector3f> pts;
-  for (int x = x0; x < x1; ++x) {
-    for (int y = y0; y < y1; ++y) {
-      for (int k = 0; k < 4; ++k) pts.emplace_back(x + 0.2f + 0.15f * k, y + 0.3f + 0.1f * k, z);
-    }
-  }
-  return pts;
-}
+using test::slab;
 
 TEST(TravelMap, StraightStepsCostACellDiagonalsRootTwo) {
   MlsMap map;
@@ -42,7 +36,7 @@ TEST(TravelMap, GoesRoundAWallAndNotUpAStep) {
   // A wall at x = 10 from y = 0 to 15: the way from (5, 5) to (15, 5) goes round its end.
   for (int y = 0; y < 15; ++y) {
     for (float z = 0; z <= 2.0f; z += 0.25f)
-      map.insert(std::vector<Eigen::Vector3f>{{10.5f, y + 0.5f, z}});
+      map.insert(std::vector<Eigen::Vector3f>{{10.5f, static_cast<float>(y) + 0.5f, z}});
   }
   // A platform 0.2 m up beyond x = 20, higher than the robot climbs.
   map.insert(slab(20, 25, 0, 20, 0.2f));

@@ -4,28 +4,21 @@
 
 #include <cmath>
 
+#include "mapping/mapping_test_support.hpp"
 #include "scanplan/sim/simulated_scanner.hpp"
 
 namespace scanplan {
 namespace {
 
-// Points filling cells [x0, x1) × [y0, y1) at height z, four per 1 m cell.
-std::vector<Eigen::Vector3f> slab(int x0, int x1, int y0, int y1, float z) {
-  std::vector<Eigen::Vector3f> pts;
-  for (int x = x0; x < x1; ++x) {
-    for (int y = y0; y < y1; ++y) {
-      for (int k = 0; k < 4; ++k) pts.emplace_back(x + 0.2f + 0.15f * k, y + 0.3f + 0.1f * k, z);
-    }
-  }
-  return pts;
-}
+using test::slab;
 
 // A column of points from z0 to z1 in each cell of [x0, x1) × [y0, y1).
 std::vector<Eigen::Vector3f> column(int x0, int x1, int y0, int y1, float z0, float z1) {
   std::vector<Eigen::Vector3f> pts;
   for (int x = x0; x < x1; ++x) {
     for (int y = y0; y < y1; ++y) {
-      for (float z = z0; z <= z1 + 1e-4f; z += 0.25f) pts.emplace_back(x + 0.5f, y + 0.5f, z);
+      for (float z = z0; z <= z1 + 1e-4f; z += 0.25f)
+        pts.emplace_back(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, z);
     }
   }
   return pts;
@@ -139,7 +132,7 @@ TEST(Visibility, SplittingRaysNearTheSensorLosesAlmostNothing) {
     both += fine.values[o] && tree.values[o];
     either += fine.values[o] || tree.values[o];
   }
-  EXPECT_GT(static_cast<double>(both) / either, 0.97);
+  EXPECT_GT(static_cast<double>(both) / static_cast<double>(either), 0.97);
 }
 
 // The prediction against what a simulated scan then really puts into the map (the scanner's
@@ -179,8 +172,8 @@ TEST(Visibility, AgreesWithTheScanItPredictsOnTheCampus) {
     both_new += p && a && r == Region::kUnscanned;
     either_new += (p || a) && r == Region::kUnscanned;
   }
-  const double iou = static_cast<double>(both) / either;
-  const double iou_new = static_cast<double>(both_new) / either_new;
+  const double iou = static_cast<double>(both) / static_cast<double>(either);
+  const double iou_new = static_cast<double>(both_new) / static_cast<double>(either_new);
   RecordProperty("iou_all", std::to_string(iou));
   RecordProperty("iou_new", std::to_string(iou_new));
   EXPECT_GT(iou, 0.75);

@@ -214,7 +214,7 @@ TEST_P(ThreedtkRegistration, AgreesWithSlam6dFromPerturbedStarts) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Threedtk, ThreedtkRegistration, ::testing::ValuesIn(kCases),
-                         [](const auto& info) { return std::string(info.param.name); });
+                         [](const auto& param_info) { return std::string(param_info.param.name); });
 
 TEST(ThreedtkRegistrationConfig, CellSizesShrinkForThisShortRangeScene) {
   SKIP_WITHOUT_3DTK_DATA();

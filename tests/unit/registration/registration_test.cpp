@@ -105,10 +105,11 @@ TEST_P(KnownTransform, RecoversTheTransformFromAPerturbedStart) {
 INSTANTIATE_TEST_SUITE_P(MethodsAndDof, KnownTransform,
                          ::testing::Combine(::testing::ValuesIn(kAllMethods),
                                             ::testing::Values(Dof::k4, Dof::k6)),
-                         [](const auto& info) {
-                           std::string name(any_method_name(std::get<0>(info.param)));
+                         [](const auto& param_info) {
+                           std::string name(any_method_name(std::get<0>(param_info.param)));
                            for (char& c : name) c = c == '-' ? '_' : c;
-                           return name + (std::get<1>(info.param) == Dof::k4 ? "_4dof" : "_6dof");
+                           return name +
+                                  (std::get<1>(param_info.param) == Dof::k4 ? "_4dof" : "_6dof");
                          });
 
 // ---------------------------------------------------------------------------------------------
@@ -159,10 +160,11 @@ TEST_P(SimulatedPair, MatchesTwoScansOfTheYard) {
 INSTANTIATE_TEST_SUITE_P(OurMethods, SimulatedPair,
                          ::testing::Combine(::testing::Values(Method::kNdtIcp, Method::kNdt),
                                             ::testing::Values(Dof::k4, Dof::k6)),
-                         [](const auto& info) {
-                           std::string name(method_name(std::get<0>(info.param)));
+                         [](const auto& param_info) {
+                           std::string name(method_name(std::get<0>(param_info.param)));
                            for (char& c : name) c = c == '-' ? '_' : c;
-                           return name + (std::get<1>(info.param) == Dof::k4 ? "_4dof" : "_6dof");
+                           return name +
+                                  (std::get<1>(param_info.param) == Dof::k4 ? "_4dof" : "_6dof");
                          });
 
 // ---------------------------------------------------------------------------------------------
@@ -220,8 +222,8 @@ TEST_P(FailingInput, SaysSoInsteadOfReturningAWrongPose) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllMethods, FailingInput, ::testing::ValuesIn(kAllMethods),
-                         [](const auto& info) {
-                           std::string name(any_method_name(info.param));
+                         [](const auto& param_info) {
+                           std::string name(any_method_name(param_info.param));
                            for (char& c : name) c = c == '-' ? '_' : c;
                            return name;
                          });
@@ -333,9 +335,12 @@ TEST(AlignmentQuality, ScoresEq2AndTellsWellPosedFromCorridor) {
   PointCloud corridor;
   for (int i = -200; i <= 200; ++i) {
     for (int k = 0; k < 10; ++k) {
-      corridor.points.emplace_back(0.2f * i, -2.0f, 0.3f * k);
-      corridor.points.emplace_back(0.2f * i, 2.0f, 0.3f * k);
-      corridor.points.emplace_back(0.2f * i, -1.8f + 0.4f * k, 0.0f);
+      corridor.points.emplace_back(0.2f * static_cast<float>(i), -2.0f,
+                                   0.3f * static_cast<float>(k));
+      corridor.points.emplace_back(0.2f * static_cast<float>(i), 2.0f,
+                                   0.3f * static_cast<float>(k));
+      corridor.points.emplace_back(0.2f * static_cast<float>(i),
+                                   -1.8f + 0.4f * static_cast<float>(k), 0.0f);
     }
   }
   EXPECT_LT(evaluate_alignment(corridor, corridor, I, Dof::k4, 1.0, 0.3).weakest_constraint, 0.001);

@@ -417,7 +417,9 @@ INSTANTIATE_TEST_SUITE_P(
                   "POST / HTTP/1.1\r\n" + kHost +
                       "Transfer-Encoding: chunked\r\n\r\n0\r\nBad Trailer: x\r\n\r\n",
                   400}),
-    [](const ::testing::TestParamInfo<ErrorCase>& info) { return std::string(info.param.name); });
+    [](const ::testing::TestParamInfo<ErrorCase>& param_info) {
+      return std::string(param_info.param.name);
+    });
 
 TEST(HttpRequestParser, AcceptsIdenticalDuplicateContentLength) {
   const auto result = parse(

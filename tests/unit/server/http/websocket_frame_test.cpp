@@ -202,7 +202,7 @@ TEST(WebSocketFrameParser, ReservedBitsAndOpcodesAreProtocolErrors) {
   std::string rsv1 = client_frame(kText, "x");
   rsv1[0] = static_cast<char>(rsv1[0] | 0x40);  // RSV1 would mean permessage-deflate
   EXPECT_EQ(parse(rsv1).error_code, websocket_close::kProtocolError);
-  for (std::uint8_t op : {0x3, 0x7, 0xB, 0xF}) {
+  for (const std::uint8_t op : std::initializer_list<std::uint8_t>{0x3, 0x7, 0xB, 0xF}) {
     EXPECT_EQ(parse(client_frame(op, "x")).error_code, websocket_close::kProtocolError)
         << "opcode " << int(op);
   }
@@ -261,12 +261,14 @@ TEST(WebSocketFrameParser, CloseFrameRules) {
 
   EXPECT_EQ(parse(client_frame(kClose, "\x03")).error_code, websocket_close::kProtocolError)
       << "one byte cannot hold a code";
-  for (std::uint16_t code : {0, 999, 1004, 1005, 1006, 1015, 2000, 2999, 5000, 65535}) {
+  for (const std::uint16_t code : std::initializer_list<std::uint16_t>{
+           0, 999, 1004, 1005, 1006, 1015, 2000, 2999, 5000, 65535}) {
     EXPECT_EQ(parse(client_frame(kClose, close_payload(code))).error_code,
               websocket_close::kProtocolError)
         << "code " << code;
   }
-  for (std::uint16_t code : {1000, 1001, 1002, 1003, 1007, 1008, 1009, 1010, 1011, 3000, 4999}) {
+  for (const std::uint16_t code : std::initializer_list<std::uint16_t>{
+           1000, 1001, 1002, 1003, 1007, 1008, 1009, 1010, 1011, 3000, 4999}) {
     EXPECT_EQ(parse(client_frame(kClose, close_payload(code))).messages.size(), 1u)
         << "code " << code;
   }

@@ -22,7 +22,10 @@ class SessionDir : public ::testing::Test {
 
 PointCloud cloud_of(int n, float offset) {
   PointCloud c;
-  for (int i = 0; i < n; ++i) c.push_back({offset + i, 2.0f * i, 0.5f}, {10, 20, 30});
+  for (int i = 0; i < n; ++i) {
+    const auto f = static_cast<float>(i);
+    c.push_back({offset + f, 2.0f * f, 0.5f}, {10, 20, 30});
+  }
   return c;
 }
 

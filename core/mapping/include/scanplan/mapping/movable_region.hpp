@@ -28,7 +28,7 @@ struct MovableConfig {
 struct MovableRegion {
   CellGrid<std::int8_t> patch;
   std::size_t cells = 0;
-  double area_m2() const { return cells * patch.cell_m * patch.cell_m; }
+  double area_m2() const { return static_cast<double>(cells) * patch.cell_m * patch.cell_m; }
   bool contains(CellIndex c) const {
     const auto o = patch.offset(c);
     return o && patch.values[*o] >= 0;

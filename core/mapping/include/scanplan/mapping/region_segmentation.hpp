@@ -25,9 +25,9 @@ struct RegionMap {
   CellGrid<Region> cells;  // covers the target region's bounding box
   std::size_t completed = 0, low_resolution = 0, unscanned = 0;
   double cell_area_m2() const { return cells.cell_m * cells.cell_m; }
-  double completed_m2() const { return completed * cell_area_m2(); }
-  double low_resolution_m2() const { return low_resolution * cell_area_m2(); }
-  double unscanned_m2() const { return unscanned * cell_area_m2(); }
+  double completed_m2() const { return static_cast<double>(completed) * cell_area_m2(); }
+  double low_resolution_m2() const { return static_cast<double>(low_resolution) * cell_area_m2(); }
+  double unscanned_m2() const { return static_cast<double>(unscanned) * cell_area_m2(); }
   // C ∪ M: the paper's "detection area" (§3.5).
   double detected_m2() const { return completed_m2() + low_resolution_m2(); }
   Region at(CellIndex c) const {

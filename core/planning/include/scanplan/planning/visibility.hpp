@@ -115,10 +115,15 @@ class VisibilityPredictor {
   };
   struct Trace;     // one call's constants
   struct RayState;  // what a ray carries outward and hands to the rays it splits into
+  struct Tracer;    // one ray's walk through the cells
   struct Ray {
     Eigen::Vector2f dir;
     std::uint32_t walk_begin, segment_begin, walk_end;  // into steps_
   };
+  // The map copied into dense_ and patches_, padded by the range around where sensors may stand.
+  void build_dense(const MlsMap& map);
+  // The tree of rays and their walks through the cells, from `sensor_offset` in a cell.
+  void build_rays(const Eigen::Vector2d& sensor_offset);
   void walk(double azimuth, double reach_cells, const Eigen::Vector2d& sensor_offset);
   void trace(const Trace& t, int level, int ray, RayState& state, Workspace& ws) const;
   void mark(const Trace& t, const Step& s, Workspace& ws) const;
