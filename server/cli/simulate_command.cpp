@@ -1,5 +1,6 @@
 #include "simulate_command.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -7,6 +8,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <vector>
 
 #include "scanplan/experiments/closed_loop.hpp"
 #include "scanplan/experiments/coverage_chart.hpp"
@@ -65,6 +67,58 @@ void write_chart(const LoopResult& r, const std::string& policy,
   cv::imwrite(file.string(), chart);
 }
 
+nlohmann::json pose_json(const Pose& p) {
+  return {{"x", p.x}, {"y", p.y}, {"z", p.z}, {"yaw_deg", rad2deg(p.yaw)}};
+}
+
+// One scan as summary.json lists it (DESIGN.md "CLI"): where the robot said it was, where the
+// map put it and where it really was, all in the map frame (the first scan's), and the match.
+nlohmann::json scan_json(const LoopStep& s, const LoopStep& first) {
+  nlohmann::json match = nullptr;
+  if (s.match) {
+    match = {{"applied", s.match_applied},  {"converged", s.match->converged},
+             {"reason", s.match->message},  {"method", s.match->method},
+             {"time_ms", s.match->time_ms}, {"inlier_ratio", s.match->inlier_ratio}};
+  }
+  return {{"scan", s.scan},
+          {"reported", pose_json(s.reported_pose)},
+          {"placed", pose_json(s.placed_pose)},
+          {"true", pose_json(true_in_map(first.placed_pose, first.true_pose, s.true_pose))},
+          {"placed_error_m", s.placed_error_m},
+          {"placed_error_deg", s.placed_error_deg},
+          {"match", match}};
+}
+
+// How the map's poses came out: matches tried and applied, and the placed error against the
+// truth relative to the first scan (median and worst over the scans after it).
+nlohmann::json accuracy_of(const LoopResult& r) {
+  std::vector<double> metres, degrees;
+  int tried = 0, applied = 0;
+  for (std::size_t k = 1; k < r.steps.size(); ++k) {
+    const LoopStep& s = r.steps[k];
+    metres.push_back(s.placed_error_m);
+    degrees.push_back(s.placed_error_deg);
+    tried += s.match.has_value();
+    applied += s.match_applied;
+  }
+  const auto median = [](std::vector<double> v) -> nlohmann::json {
+    if (v.empty()) return nullptr;
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  };
+  const auto worst = [](const std::vector<double>& v) -> nlohmann::json {
+    if (v.empty()) return nullptr;
+    return *std::max_element(v.begin(), v.end());
+  };
+  return {{"matches_tried", tried},
+          {"matches_applied", applied},
+          {"placed_error_median_m", median(metres)},
+          {"placed_error_median_deg", median(degrees)},
+          {"placed_error_max_m", worst(metres)},
+          {"placed_error_max_deg", worst(degrees)}};
+}
+
 nlohmann::json summary_of(const SimulateArgs& a, const World& world, const ClosedLoopConfig& config,
                           const LoopResult& r) {
   double plan_ms = 0;
@@ -75,9 +129,10 @@ nlohmann::json summary_of(const SimulateArgs& a, const World& world, const Close
   const LoopStep& last = r.steps.back();
   // Where each scan was really taken (x, y, z, yaw_deg): to take the same scans again, e.g.
   // with `scanplan scan` for a server benchmark.
-  nlohmann::json true_poses = nlohmann::json::array();
+  nlohmann::json true_poses = nlohmann::json::array(), scans = nlohmann::json::array();
   for (const auto& s : r.steps) {
     true_poses.push_back({s.true_pose.x, s.true_pose.y, s.true_pose.z, rad2deg(s.true_pose.yaw)});
+    scans.push_back(scan_json(s, r.steps.front()));
   }
   const double cell_m = config.pipeline.mls.cell_m;
   return {{"world", world.name},
@@ -85,7 +140,7 @@ nlohmann::json summary_of(const SimulateArgs& a, const World& world, const Close
           {"alpha", a.alpha},
           {"seed", a.seed},
           {"match", a.match},
-          {"scans", r.steps.size()},
+          {"scans", scans},
           {"detected_m2", last.detected_m2},
           {"completed_m2", last.completed_m2},
           {"coverage_pct", last.coverage_pct},
@@ -95,6 +150,7 @@ nlohmann::json summary_of(const SimulateArgs& a, const World& world, const Close
           {"path_to_95pct_m", optional_json(r.path_to_95pct_m)},
           {"mean_plan_ms", plans ? plan_ms / plans : 0.0},
           {"stopped", r.stopped_because},
+          {"accuracy", accuracy_of(r)},
           {"true_poses", true_poses},
           {"out", a.out}};
 }
@@ -107,12 +163,13 @@ void run_simulate(const SimulateArgs& a) {
 
   std::ofstream csv(out / "coverage.csv");
   if (!csv) throw std::runtime_error("cannot write " + (out / "coverage.csv").string());
-  csv << "scan,x,y,detected_m2,completed_m2,coverage_pct,path_m,plan_ms\n";
+  csv << "scan,x,y,detected_m2,completed_m2,coverage_pct,path_m,plan_ms,placed_error_m,"
+         "placed_error_deg\n";
   const auto on_step = [&](const LoopStep& s, const MappingPipeline& pipeline) {
     char row[256];
-    std::snprintf(row, sizeof row, "%d,%.3f,%.3f,%.1f,%.1f,%.2f,%.2f,%.1f\n", s.scan, s.true_pose.x,
-                  s.true_pose.y, s.detected_m2, s.completed_m2, s.coverage_pct, s.path_m,
-                  s.plan_ms);
+    std::snprintf(row, sizeof row, "%d,%.3f,%.3f,%.1f,%.1f,%.2f,%.2f,%.1f,%.4f,%.3f\n", s.scan,
+                  s.true_pose.x, s.true_pose.y, s.detected_m2, s.completed_m2, s.coverage_pct,
+                  s.path_m, s.plan_ms, s.placed_error_m, s.placed_error_deg);
     csv << row << std::flush;
     cv::Mat img = render_regions(*pipeline.regions(), &*pipeline.movable(), pipeline.scan_points());
     draw_plan(img, *pipeline.regions(), s.candidates, s.chosen);
@@ -120,7 +177,12 @@ void run_simulate(const SimulateArgs& a) {
     std::snprintf(name, sizeof name, "step_%02d.png", s.scan);
     cv::imwrite((out / name).string(), img);
     std::cerr << "scan " << s.scan << ": detected " << s.detected_m2 << " m², coverage "
-              << s.coverage_pct << " %, plan " << s.plan_ms << " ms\n";
+              << s.coverage_pct << " %, plan " << s.plan_ms << " ms";
+    if (s.match) {
+      std::cerr << ", match " << (s.match_applied ? "applied" : "not applied") << ", placed "
+                << s.placed_error_m << " m / " << s.placed_error_deg << "° from the truth";
+    }
+    std::cerr << "\n";
   };
   const LoopResult r = run_closed_loop(world, config, on_step);
   write_chart(r, a.policy, out / "coverage.png");

@@ -17,10 +17,32 @@ test('simulate on the tree-row world', { timeout: 120000 }, () => {
     assert.equal(run.status, 0, run.stderr);
     const summary = JSON.parse(run.stdout);
     assert.equal(summary.world, 'tree_row');
-    assert.ok(summary.scans >= 2 && summary.scans <= 4, JSON.stringify(summary));
+    const n = summary.scans.length;
+    assert.ok(n >= 2 && n <= 4, JSON.stringify(summary));
+    // Each scan: reported, placed and true pose in the map frame, and the match (none for the
+    // first, which defines the map frame; the placed error is measured against it).
+    const pose = (p) => ['x', 'y', 'z', 'yaw_deg'].every((k) => Number.isFinite(p[k]));
+    summary.scans.forEach((s, i) => {
+      assert.equal(s.scan, i + 1);
+      assert.ok(pose(s.reported) && pose(s.placed) && pose(s.true), JSON.stringify(s));
+      assert.ok(s.placed_error_m >= 0 && s.placed_error_deg >= 0);
+      if (i === 0) {
+        assert.equal(s.match, null);
+        assert.equal(s.placed_error_m, 0);
+        assert.ok(Math.abs(s.true.x - s.placed.x) < 1e-9, 'the first scan defines the map frame');
+      } else {
+        assert.equal(typeof s.match.applied, 'boolean');
+        assert.equal(typeof s.match.converged, 'boolean');
+        assert.equal(typeof s.match.reason, 'string');
+        if (!s.match.applied) assert.deepEqual(s.placed, s.reported);
+      }
+    });
+    assert.equal(summary.accuracy.matches_tried, n - 1);
+    assert.ok(summary.accuracy.matches_applied <= n - 1);
     const rows = readFileSync(join(out, 'coverage.csv'), 'utf8').trim().split('\n');
-    assert.equal(rows[0], 'scan,x,y,detected_m2,completed_m2,coverage_pct,path_m,plan_ms');
-    assert.equal(rows.length, summary.scans + 1);
+    assert.equal(rows[0],
+      'scan,x,y,detected_m2,completed_m2,coverage_pct,path_m,plan_ms,placed_error_m,placed_error_deg');
+    assert.equal(rows.length, n + 1);
     const cov = rows.slice(1).map((r) => r.split(',').map(Number));
     for (let i = 1; i < cov.length; i++) {
       assert.ok(cov[i][3] >= cov[i - 1][3], 'the detected area never shrinks');
@@ -28,7 +50,10 @@ test('simulate on the tree-row world', { timeout: 120000 }, () => {
     }
     assert.ok(cov.at(-1)[5] > 60, `coverage ${cov.at(-1)[5]} %`);
     assert.ok(Math.abs(summary.coverage_pct - cov.at(-1)[5]) < 0.01);
-    for (let i = 1; i <= summary.scans; i++) {
+    cov.forEach((row, i) => {
+      assert.ok(Math.abs(row[8] - summary.scans[i].placed_error_m) < 1e-3, 'csv and summary agree');
+    });
+    for (let i = 1; i <= n; i++) {
       assert.ok(existsSync(join(out, `step_${String(i).padStart(2, '0')}.png`)));
     }
     const bad = spawnSync(requireEnv('SCANPLAN_CLI'), ['simulate', '--world',

@@ -58,6 +58,18 @@ std::optional<std::size_t> drive_to_best(const WorldTraversability& trav,
 
 }  // namespace
 
+Pose true_in_map(const Pose& first_placed, const Pose& first_true, const Pose& truth) {
+  return Pose::from_isometry(first_placed.isometry() * first_true.isometry().inverse() *
+                             truth.isometry());
+}
+
+PoseError placed_error(const Pose& first_placed, const Pose& first_true, const Pose& placed,
+                       const Pose& truth) {
+  const Eigen::Isometry3d e =
+      true_in_map(first_placed, first_true, truth).isometry().inverse() * placed.isometry();
+  return {e.translation().norm(), rad2deg(Eigen::AngleAxisd(e.linear()).angle())};
+}
+
 LoopResult run_closed_loop(
     const World& world, const ClosedLoopConfig& config,
     const std::function<void(const LoopStep&, const MappingPipeline&)>& on_step) {
@@ -87,9 +99,17 @@ LoopResult run_closed_loop(
     step.placed_pose = step.reported_pose;
     if (const auto m = mission.place(cloud, step.reported_pose)) {
       step.match = m->result;
+      step.match_applied = m->applied;
       step.placed_pose = m->placed;
     }
     mission.add(cloud, step.placed_pose);
+    if (!result.steps.empty()) {
+      const LoopStep& first = result.steps.front();
+      const PoseError e =
+          placed_error(first.placed_pose, first.true_pose, step.placed_pose, step.true_pose);
+      step.placed_error_m = e.metres;
+      step.placed_error_deg = e.degrees;
+    }
 
     const RegionMap& regions = *pipeline.regions();
     step.detected_m2 = regions.detected_m2();

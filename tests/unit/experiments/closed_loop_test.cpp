@@ -65,6 +65,7 @@ TEST(ClosedLoop, MatchedScansLandWhereTheyWereTakenAndRefusedOnesStayReported) {
   for (std::size_t k = 1; k < r.steps.size(); ++k) {
     const LoopStep& s = r.steps[k];
     ASSERT_TRUE(s.match) << "scan " << s.scan << " was not matched";
+    EXPECT_EQ(s.match_applied, s.match->converged) << "a refused correction is not converged";
     if (!s.match->converged) {
       EXPECT_EQ(s.placed_pose.x, s.reported_pose.x) << s.match->message;
       EXPECT_EQ(s.placed_pose.yaw, s.reported_pose.yaw) << s.match->message;
@@ -76,7 +77,35 @@ TEST(ClosedLoop, MatchedScansLandWhereTheyWereTakenAndRefusedOnesStayReported) {
     const Eigen::Isometry3d error = truth.inverse() * placed;
     EXPECT_LT(error.translation().norm(), 0.10) << "scan " << s.scan;
     EXPECT_LT(rad2deg(Eigen::AngleAxisd(error.linear()).angle()), 0.5) << "scan " << s.scan;
+    EXPECT_TRUE(s.match_applied);
+    // The step carries the same error, as simulate reports it.
+    EXPECT_NEAR(s.placed_error_m, error.translation().norm(), 1e-6);
+    EXPECT_NEAR(s.placed_error_deg, rad2deg(Eigen::AngleAxisd(error.linear()).angle()), 1e-6);
   }
+}
+
+TEST(ClosedLoop, PlacedErrorIsRelativeToTheFirstScan) {
+  // The whole map shifted and turned by the first scan's error has no error at all.
+  Pose first_true, first_placed, truth;
+  first_true.x = 10;
+  first_true.yaw = deg2rad(30);
+  first_placed = first_true;
+  first_placed.x += 0.7;
+  first_placed.y -= 0.4;
+  first_placed.yaw += deg2rad(4);
+  truth.x = 25;
+  truth.y = 8;
+  truth.yaw = deg2rad(-50);
+  const Pose consistent = true_in_map(first_placed, first_true, truth);
+  const PoseError none = placed_error(first_placed, first_true, consistent, truth);
+  EXPECT_NEAR(none.metres, 0, 1e-9);
+  EXPECT_NEAR(none.degrees, 0, 1e-6);
+  EXPECT_NEAR(placed_error(first_true, first_true, truth, truth).metres, 0, 1e-12);
+  // Placed where the robot really was, in a map whose frame is off by the first error: wrong
+  // by that error carried 15 m along.
+  const PoseError off = placed_error(first_placed, first_true, truth, truth);
+  EXPECT_GT(off.metres, 0.5);
+  EXPECT_NEAR(off.degrees, 4, 1e-6);
 }
 
 }  // namespace

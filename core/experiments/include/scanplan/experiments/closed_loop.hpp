@@ -28,7 +28,12 @@ struct LoopStep {
   Pose true_pose;      // where the robot really scanned
   Pose reported_pose;  // what the robot's pose sensors said
   Pose placed_pose;    // where the map put the scan (matched when matching is on)
-  std::optional<RegistrationResult> match;
+  std::optional<RegistrationResult> match;  // when the scan was matched against the map
+  bool match_applied = false;               // whether placed_pose is the match's correction
+  // How far placed_pose is from the truth, relative to the first scan (which defines the map
+  // frame): what a rescue crew reading the map would be misled by.
+  double placed_error_m = 0;
+  double placed_error_deg = 0;
   double detected_m2 = 0;             // C ∪ M, the paper's detection area
   double completed_m2 = 0;            // C
   double coverage_pct = 0;            // reachable ground cells of the target region that are in C
@@ -37,6 +42,18 @@ struct LoopStep {
   std::vector<Candidate> candidates;  // ranked, as the operator would see them
   std::optional<std::size_t> chosen;  // the candidate driven to, if any
 };
+
+// The true pose `truth` in the map frame, which the first scan defines: the first scan's true
+// pose maps onto where it was placed.
+Pose true_in_map(const Pose& first_placed, const Pose& first_true, const Pose& truth);
+
+// The placed pose's error against the truth relative to the first scan: translation (m) and
+// rotation angle (degrees) of true_in_map(...)⁻¹ · placed.
+struct PoseError {
+  double metres = 0, degrees = 0;
+};
+PoseError placed_error(const Pose& first_placed, const Pose& first_true, const Pose& placed,
+                       const Pose& truth);
 
 struct LoopResult {
   std::vector<LoopStep> steps;
