@@ -101,7 +101,12 @@ void serve(http::ServerConfig config, int count, const http::Router& router,
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   std::signal(SIGPIPE, SIG_IGN);
-  listening(config.port);
+  try {
+    listening(config.port);
+  } catch (...) {
+    g_servers.fill(nullptr);  // the servers go with this frame: no signal may reach them
+    throw;
+  }
   std::vector<std::thread> loops;
   for (std::size_t k = 1; k < servers.size(); ++k) {
     loops.emplace_back([&servers, k] {
@@ -130,6 +135,8 @@ void serve(http::ServerConfig config, int count, const http::Router& router,
 
 // The whole server: storage, the application, DDS and HTTP, wired and run until stopped.
 void run(const Options& o) {
+  // Flags first: a mistyped --listen must not open (or create) a session.
+  const http::ServerConfig config = server_config(o);
   std::string operator_token = env_or_empty("SCANPLAN_OPERATOR_TOKEN");
   const bool generated = operator_token.empty();
   if (generated) operator_token = srv::Auth::random_token();
@@ -167,7 +174,6 @@ void run(const Options& o) {
   router.set_fallback(
       [&files](const http::Request& r, const http::Router::Params&) { return files.serve(r); });
 
-  const http::ServerConfig config = server_config(o);
   serve(config, o.http_threads, router, [&](std::uint16_t port) {
     hub.start();
     intake.start();

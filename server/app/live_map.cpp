@@ -66,20 +66,29 @@ const std::vector<std::string>& LiveMap::layer_names() {
 }
 
 std::optional<MapMatch> LiveMap::place(const PointCloud& scan, const Pose& reported) const {
-  std::lock_guard encode_lock(encode_mutex_);
-  return mission_.place(scan, reported);
+  // Only the copy of the map's points near the scan under the lock: the match itself takes
+  // hundreds of milliseconds, and parameter changes and goals must not wait for it.
+  std::optional<MissionPipeline::MatchInput> in;
+  {
+    std::lock_guard encode_lock(encode_mutex_);
+    in = mission_.match_input(reported);
+  }
+  if (!in) return std::nullopt;
+  return match_to_map(in->map_points, scan, reported, in->config);
 }
 
 std::vector<PlanRecord> LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
   const Pose& pose = scan.placed;
-  // Writers take turns on encode_mutex_; readers only wait for the short commit below, and
-  // they see the scan, its points, its chunk and the plan that includes it appear together.
-  std::lock_guard encode_lock(encode_mutex_);
-  std::shared_ptr<const PointCloud> shared = mission_.add(cloud, pose);
+  // The scan in the map frame and its own Draco chunk first: should either fail (out of
+  // memory, a Draco error), nothing of the scan has reached the map yet.
+  std::shared_ptr<const PointCloud> shared = MissionPipeline::to_map_frame(cloud, pose);
   const Bounds3 added = bounds_of(*shared);
   std::shared_ptr<const std::string> chunk;
   if (!shared->empty()) chunk = std::make_shared<const std::string>(encode_draco(*shared));
-
+  // Writers take turns on encode_mutex_; readers only wait for the short commit below, and
+  // they see the scan, its points, its chunk and the plan that includes it appear together.
+  std::lock_guard encode_lock(encode_mutex_);
+  mission_.add(cloud, pose, shared);
   thinned_.add(*shared);
   last_scan_ = {scan.id, scan.robot};
   scan_pose_of_[scan.robot] = pose;

@@ -88,7 +88,9 @@ void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud) {
   if (const auto chunk = live_.encoded_chunk(scan.id)) events_.map_chunk(scan.id, *chunk);
   const MapAreas a = live_.areas();
   events_.publish("map_updated", map_updated_json(scan, a));
-  // One plan per robot that is not driving; the scanning robot's first.
+  // One plan per robot that is not driving, by robot id; the scanning robot's first.
+  std::sort(plans.begin(), plans.end(),
+            [](const PlanRecord& p, const PlanRecord& q) { return p.robot < q.robot; });
   std::stable_partition(plans.begin(), plans.end(),
                         [&](const PlanRecord& p) { return p.robot == scan.robot; });
   for (const PlanRecord& plan : plans) {

@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <limits>
 
 #include "http/http_error.hpp"
 
@@ -45,7 +46,9 @@ double query_number(const Request& r, const std::string& name) {
 std::uint64_t path_id(const std::string& text, const char* what) {
   std::uint64_t n = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
-  if (ec != std::errc() || end != text.data() + text.size() || n == 0) {
+  // Every id fits a signed 64-bit integer (SQLite's rowid).
+  constexpr auto kMax = static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
+  if (ec != std::errc() || end != text.data() + text.size() || n == 0 || n > kMax) {
     throw HttpError(400, "bad_request",
                     std::string(what) + " is a positive whole number, got '" + text + "'");
   }

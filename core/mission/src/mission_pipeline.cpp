@@ -22,13 +22,21 @@ bool MissionPipeline::has_map() const {
   return mapping_.regions() && mapping_.movable() && mapping_.target();
 }
 
-std::optional<MapMatch> MissionPipeline::place(const PointCloud& scan, const Pose& reported) const {
+std::optional<MissionPipeline::MatchInput> MissionPipeline::match_input(
+    const Pose& reported) const {
   if (!config_.matching || placed_.empty()) return std::nullopt;
-  return match_to_map(points_near(reported.x, reported.y, config_.matching->target_radius_m), scan,
-                      reported, *config_.matching);
+  return MatchInput{points_near(reported.x, reported.y, config_.matching->target_radius_m),
+                    *config_.matching};
 }
 
-std::shared_ptr<const PointCloud> MissionPipeline::add(const PointCloud& scan, const Pose& placed) {
+std::optional<MapMatch> MissionPipeline::place(const PointCloud& scan, const Pose& reported) const {
+  const std::optional<MatchInput> in = match_input(reported);
+  if (!in) return std::nullopt;
+  return match_to_map(in->map_points, scan, reported, in->config);
+}
+
+std::shared_ptr<const PointCloud> MissionPipeline::to_map_frame(const PointCloud& scan,
+                                                                const Pose& placed) {
   const Eigen::Affine3f map_from_scan = placed.isometry().cast<float>();
   PointCloud in_map;
   in_map.reserve(scan.size());
@@ -36,9 +44,18 @@ std::shared_ptr<const PointCloud> MissionPipeline::add(const PointCloud& scan, c
     in_map.push_back(map_from_scan * scan.points[i],
                      scan.has_colors() ? scan.colors[i] : Rgb{128, 128, 128});
   }
-  mapping_.add_scan(scan, placed);
-  placed_.push_back(std::make_shared<const PointCloud>(std::move(in_map)));
+  return std::make_shared<const PointCloud>(std::move(in_map));
+}
+
+std::shared_ptr<const PointCloud> MissionPipeline::add(const PointCloud& scan, const Pose& placed) {
+  add(scan, placed, to_map_frame(scan, placed));
   return placed_.back();
+}
+
+void MissionPipeline::add(const PointCloud& scan, const Pose& placed,
+                          std::shared_ptr<const PointCloud> in_map) {
+  mapping_.add_scan(scan, placed);
+  placed_.push_back(std::move(in_map));
 }
 
 std::vector<FleetPlan> MissionPipeline::plan(const std::vector<FleetRobot>& robots,

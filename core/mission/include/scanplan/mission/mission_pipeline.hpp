@@ -16,6 +16,8 @@
 namespace scanplan {
 
 struct MissionConfig {
+  // The segmentation's and the movable region's thresholds are the planner's
+  // (planner.regions, planner.movable): mapping.regions and mapping.movable are not used.
   PipelineConfig mapping;
   PlannerConfig planner;
   // Scan matching of each new scan against the map so far (paper §4); nothing: scans go where
@@ -36,10 +38,20 @@ class MissionPipeline {
   // `reported` (MapMatchConfig::target_radius_m). Nothing when matching is off or the map is
   // still empty (the first scan defines the map frame). Changes nothing.
   std::optional<MapMatch> place(const PointCloud& scan, const Pose& reported) const;
+  // place() in two steps, for an owner that matches without holding its lock: what the match
+  // needs from the map (nothing when there is nothing to match against), then match_to_map.
+  struct MatchInput {
+    PointCloud map_points;
+    MapMatchConfig config;
+  };
+  std::optional<MatchInput> match_input(const Pose& reported) const;
 
   // Mapped and segmented: the scan joins the map at `placed`. Returns its points in the map
   // frame (coloured; grey where the scan had no colour), shared, never copied again.
   std::shared_ptr<const PointCloud> add(const PointCloud& scan, const Pose& placed);
+  // The same with the points in the map frame already made (to_map_frame).
+  void add(const PointCloud& scan, const Pose& placed, std::shared_ptr<const PointCloud> in_map);
+  static std::shared_ptr<const PointCloud> to_map_frame(const PointCloud& scan, const Pose& placed);
 
   // Planned: the next scan point for each robot (plan_fleet, PlanInput::claimed for `claimed`,
   // the goals of robots already driving). Empty before the first scan.
