@@ -43,7 +43,15 @@ run() {
   return $status
 }
 
+# check-sanitizers.sh [asan] [tsan]: both by default.
 total=$SECONDS
-run asan address,undefined
-run tsan thread
+for which in "${@:-asan tsan}"; do
+  for w in $which; do
+    case "$w" in
+      asan) run asan address,undefined ;;
+      tsan) run tsan thread ;;
+      *) echo "unknown sanitizer run '$w' (asan or tsan)" >&2; exit 2 ;;
+    esac
+  done
+done
 echo "check-sanitizers: clean in $((SECONDS - total)) s" >&2

@@ -52,7 +52,9 @@ std::vector<std::string> top_view(const OperatorClient& client, const json& answ
       notes.push_back(std::string("(regions not shown: ") + e.what() + ")");
     }
   }
-  for (const json& s : client.get_json("/api/v1/scans", "list the scans").at("scans")) {
+  // Named: a range-for over a part of a temporary would outlive it (found by AddressSanitizer).
+  const json scans = client.get_json("/api/v1/scans", "list the scans");
+  for (const json& s : scans.at("scans")) {
     in.scan_points.push_back(
         {s.at("placed").at("x").get<double>(), s.at("placed").at("y").get<double>()});
   }
