@@ -1,6 +1,8 @@
 #include "scanplan/registration/line_segment_icp.hpp"
 
+#ifdef _OPENMP
 #include <omp.h>
+#endif
 
 #include <Eigen/Cholesky>
 #include <algorithm>
@@ -116,7 +118,11 @@ RegistrationResult align(const PointCloud& target, const PointCloud& source,
     return result;
   }
   const detail::PointKdTree tree(target.points);
+#ifdef _OPENMP
   const int threads = config.num_threads > 0 ? config.num_threads : omp_get_max_threads();
+#else
+  const int threads = config.num_threads > 0 ? config.num_threads : 1;
+#endif
   const double floor_distance = std::min(config.min_correspondence_m, config.max_correspondence_m);
   double distance = config.max_correspondence_m;
   double previous_error = -1;  // at the same rejection distance, else -1

@@ -1,6 +1,8 @@
 #include "scanplan/registration/narrower_ndt.hpp"
 
+#ifdef _OPENMP
 #include <omp.h>
+#endif
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -260,7 +262,11 @@ RegistrationResult align(const PointCloud& target, const PointCloud& source,
     result.message = "no NDT cell sizes configured";
     return result;
   }
+#ifdef _OPENMP
   const int threads = config.num_threads > 0 ? config.num_threads : omp_get_max_threads();
+#else
+  const int threads = config.num_threads > 0 ? config.num_threads : 1;
+#endif
   for (std::size_t level = 0; level < config.cell_sizes_m.size(); ++level) {
     const double cell = config.cell_sizes_m[level];
     if (!(cell > 0)) {
