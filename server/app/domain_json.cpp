@@ -25,6 +25,16 @@ json layer_geometry_json(const LayerGeometry& g) {
           {"height", g.height}};
 }
 
+namespace {
+
+json match_json(const std::optional<StoredMatch>& m) {
+  if (!m) return nullptr;
+  return {{"applied", m->applied}, {"converged", m->converged}, {"method", m->method},
+          {"reason", m->reason},   {"time_ms", m->time_ms},     {"inlier_ratio", m->inlier_ratio}};
+}
+
+}  // namespace
+
 json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas) {
   return {{"id", s.id},
           {"robot", s.robot},
@@ -32,6 +42,7 @@ json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas) {
           {"estimated", pose_json(s.estimated)},
           {"placed", pose_json(s.placed)},
           {"received_at", s.received_at},
+          {"match", match_json(s.match)},
           {"areas", areas ? areas_json(*areas) : json(nullptr)}};
 }
 

@@ -88,7 +88,7 @@ std::vector<PlanRecord> LiveMap::add(const StoredScan& scan, const PointCloud& c
   // Writers take turns on encode_mutex_; readers only wait for the short commit below, and
   // they see the scan, its points, its chunk and the plan that includes it appear together.
   std::lock_guard encode_lock(encode_mutex_);
-  mission_.add(cloud, pose, shared);
+  mission_.add(cloud, pose, scan.match && scan.match->applied, shared);
   thinned_.add(*shared);
   last_scan_ = {scan.id, scan.robot};
   scan_pose_of_[scan.robot] = pose;

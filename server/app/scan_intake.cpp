@@ -70,6 +70,11 @@ StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
   const MapMatch& m = *matched;
   const Pose& e = scan.estimated;
   const Pose& p = m.placed;
+  scan.match = StoredMatch{m.applied,        m.result.converged,
+                           m.result.method,  m.applied ? std::string() : m.result.message,
+                           m.result.time_ms, m.result.inlier_ratio};
+  if (m.applied) scan.placed = p;
+  session_.record_match(scan.id, *scan.match, p);
   events_.publish("match_done", match_done_json(scan.id, e, m));
   if (!m.applied) {
     spdlog::warn("scan {} stays at its reported pose: {}", scan.id, m.result.message);
@@ -78,8 +83,6 @@ StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
   spdlog::info("scan {} matched ({}): moved {:.2f} m, {:.2f}°, score {:.1f}, {:.0f} ms", scan.id,
                m.result.method, std::hypot(p.x - e.x, p.y - e.y),
                rad2deg(std::remainder(p.yaw - e.yaw, 2 * M_PI)), m.result.score, m.result.time_ms);
-  scan.placed = p;
-  session_.set_placed(scan.id, p);
   return scan;
 }
 

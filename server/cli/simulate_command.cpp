@@ -79,6 +79,11 @@ nlohmann::json scan_json(const LoopStep& s, const LoopStep& first) {
     match = {{"applied", s.match_applied},  {"converged", s.match->converged},
              {"reason", s.match->message},  {"method", s.match->method},
              {"time_ms", s.match->time_ms}, {"inlier_ratio", s.match->inlier_ratio}};
+    // The result's own error, applied or not: a right match refused, or a wrong one applied.
+    if (s.match_error_m) {
+      match["error_m"] = *s.match_error_m;
+      match["error_deg"] = *s.match_error_deg;
+    }
   }
   return {{"scan", s.scan},
           {"reported", pose_json(s.reported_pose)},

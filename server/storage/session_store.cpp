@@ -72,6 +72,7 @@ class Statement {
     throw SessionStoreError(std::string("session database: ") + sqlite3_errmsg(db_));
   }
   double real(int col) const { return sqlite3_column_double(stmt_, col); }
+  bool null(int col) const { return sqlite3_column_type(stmt_, col) == SQLITE_NULL; }
   std::int64_t integer(int col) const { return sqlite3_column_int64(stmt_, col); }
   std::string text(int col) const {
     const auto* t = sqlite3_column_text(stmt_, col);
@@ -91,6 +92,11 @@ class Statement {
 constexpr const char* kScanColumns =
     "id, robot, est_x, est_y, est_z, est_roll, est_pitch, est_yaw, x, y, z, roll, pitch, yaw, "
     "stamp_ns, points, file, received_at";
+// A scan with its match, if it has one: scan_from_row reads these columns.
+const std::string kScanSelect =
+    std::string("SELECT ") + kScanColumns +
+    ", applied, converged, method, reason, time_ms, inlier_ratio FROM scans LEFT JOIN matches "
+    "ON matches.scan_id = scans.id";
 
 StoredScan scan_from_row(const Statement& s) {
   StoredScan r;
@@ -102,6 +108,10 @@ StoredScan scan_from_row(const Statement& s) {
   r.points = static_cast<std::size_t>(s.integer(15));
   r.file = s.text(16);
   r.received_at = s.text(17);
+  if (!s.null(18)) {
+    r.match = StoredMatch{s.integer(18) != 0, s.integer(19) != 0, s.text(20),
+                          s.text(21),         s.real(22),         s.real(23)};
+  }
   return r;
 }
 
@@ -131,6 +141,10 @@ SessionStore::SessionStore(std::filesystem::path dir) : dir_(std::move(dir)) {
       "est_x REAL, est_y REAL, est_z REAL, est_roll REAL, est_pitch REAL, est_yaw REAL, "
       "x REAL, y REAL, z REAL, roll REAL, pitch REAL, yaw REAL, stamp_ns INTEGER, "
       "points INTEGER, file TEXT NOT NULL, received_at TEXT NOT NULL)");
+  exec(
+      "CREATE TABLE IF NOT EXISTS matches(scan_id INTEGER PRIMARY KEY REFERENCES scans(id), "
+      "applied INTEGER NOT NULL, converged INTEGER NOT NULL, method TEXT NOT NULL, "
+      "reason TEXT NOT NULL, time_ms REAL NOT NULL, inlier_ratio REAL NOT NULL)");
   exec(
       "CREATE TABLE IF NOT EXISTS events(id INTEGER PRIMARY KEY, at TEXT NOT NULL, "
       "kind TEXT NOT NULL, json TEXT NOT NULL)");
@@ -208,19 +222,34 @@ StoredScan SessionStore::add_scan(const std::string& robot, const Pose& estimate
   }
 }
 
-void SessionStore::set_placed(std::int64_t id, const Pose& p) {
+void SessionStore::record_match(std::int64_t id, const StoredMatch& m, const Pose& p) {
   std::lock_guard lock(mutex_);
-  Statement s(db_,
-              "UPDATE scans SET x = ?, y = ?, z = ?, roll = ?, pitch = ?, yaw = ? WHERE id = ?");
-  s.bind(1, p.x).bind(2, p.y).bind(3, p.z).bind(4, p.roll).bind(5, p.pitch).bind(6, p.yaw);
-  s.bind(7, id);
-  s.step();
+  exec("BEGIN IMMEDIATE");
+  try {
+    Statement ins(db_,
+                  "INSERT OR REPLACE INTO matches(scan_id, applied, converged, method, reason, "
+                  "time_ms, inlier_ratio) VALUES(?,?,?,?,?,?,?)");
+    ins.bind(1, id).bind(2, std::int64_t{m.applied}).bind(3, std::int64_t{m.converged});
+    ins.bind(4, m.method).bind(5, m.reason).bind(6, m.time_ms).bind(7, m.inlier_ratio);
+    ins.step();
+    if (m.applied) {
+      Statement s(
+          db_, "UPDATE scans SET x = ?, y = ?, z = ?, roll = ?, pitch = ?, yaw = ? WHERE id = ?");
+      s.bind(1, p.x).bind(2, p.y).bind(3, p.z).bind(4, p.roll).bind(5, p.pitch).bind(6, p.yaw);
+      s.bind(7, id);
+      s.step();
+    }
+    exec("COMMIT");
+  } catch (...) {
+    exec("ROLLBACK");
+    throw;
+  }
 }
 
 std::vector<StoredScan> SessionStore::scans() const {
   std::lock_guard lock(mutex_);
   std::vector<StoredScan> out;
-  Statement s(db_, (std::string("SELECT ") + kScanColumns + " FROM scans ORDER BY id").c_str());
+  Statement s(db_, (kScanSelect + " ORDER BY id").c_str());
   while (s.step()) out.push_back(scan_from_row(s));
   return out;
 }
@@ -238,7 +267,7 @@ std::vector<SessionEvent> SessionStore::events(std::size_t limit) const {
 
 std::optional<StoredScan> SessionStore::scan(std::int64_t id) const {
   std::lock_guard lock(mutex_);
-  Statement s(db_, (std::string("SELECT ") + kScanColumns + " FROM scans WHERE id = ?").c_str());
+  Statement s(db_, (kScanSelect + " WHERE id = ?").c_str());
   s.bind(1, id);
   if (!s.step()) return std::nullopt;
   return scan_from_row(s);

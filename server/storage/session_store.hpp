@@ -22,6 +22,16 @@ class SessionStoreError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// How matching placed a scan (paper §4; MapMatch): recorded once the match ran.
+struct StoredMatch {
+  bool applied = false;    // the scan sits where the match put it
+  bool converged = false;  // the match settled and passed the sanity check
+  std::string method;      // "search-gicp", "ndt-icp", ...
+  std::string reason;      // why it was not applied (empty when it was)
+  double time_ms = 0;
+  double inlier_ratio = 0;
+};
+
 struct StoredScan {
   std::int64_t id = 0;
   std::string robot;
@@ -29,8 +39,9 @@ struct StoredScan {
   Pose placed;     // where the map put the scan (after matching)
   std::int64_t stamp_ns = 0;
   std::size_t points = 0;
-  std::string file;         // the scan's PLY, relative to the session directory
-  std::string received_at;  // UTC, ISO 8601
+  std::string file;                  // the scan's PLY, relative to the session directory
+  std::string received_at;           // UTC, ISO 8601
+  std::optional<StoredMatch> match;  // none for the first scan, with matching off, or not yet
 };
 
 // One row of the session's record of what happened (append_event).
@@ -77,8 +88,9 @@ class SessionStore {
   // `cloud` in the scan's own frame. Returns the new scan with its id.
   StoredScan add_scan(const std::string& robot, const Pose& estimated, const Pose& placed,
                       std::int64_t stamp_ns, const PointCloud& cloud);
-  // Records where matching placed scan `id` in the map.
-  void set_placed(std::int64_t id, const Pose& placed);
+  // Records how matching went for scan `id` and, when it was applied, where it placed the
+  // scan: both in one transaction.
+  void record_match(std::int64_t id, const StoredMatch& match, const Pose& placed);
   std::vector<StoredScan> scans() const;
   // The newest `limit` events recorded with append_event, oldest first.
   std::vector<SessionEvent> events(std::size_t limit) const;

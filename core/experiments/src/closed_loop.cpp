@@ -97,18 +97,26 @@ LoopResult run_closed_loop(
                                            config.seed * 7919 + static_cast<std::uint64_t>(scan));
     step.reported_pose = reported_pose(truth, world.pose_noise, pose_rng);
     step.placed_pose = step.reported_pose;
+    std::optional<Pose> proposed;
     if (const auto m = mission.place(cloud, step.reported_pose)) {
       step.match = m->result;
       step.match_applied = m->applied;
       step.placed_pose = m->placed;
+      proposed = m->proposed;
     }
-    mission.add(cloud, step.placed_pose);
+    mission.add(cloud, step.placed_pose, step.match_applied);
     if (!result.steps.empty()) {
       const LoopStep& first = result.steps.front();
       const PoseError e =
           placed_error(first.placed_pose, first.true_pose, step.placed_pose, step.true_pose);
       step.placed_error_m = e.metres;
       step.placed_error_deg = e.degrees;
+      if (proposed) {
+        const PoseError m =
+            placed_error(first.placed_pose, first.true_pose, *proposed, step.true_pose);
+        step.match_error_m = m.metres;
+        step.match_error_deg = m.degrees;
+      }
     }
 
     const RegionMap& regions = *pipeline.regions();

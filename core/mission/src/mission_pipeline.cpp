@@ -25,7 +25,8 @@ bool MissionPipeline::has_map() const {
 std::optional<MissionPipeline::MatchInput> MissionPipeline::match_input(
     const Pose& reported) const {
   if (!config_.matching || placed_.empty()) return std::nullopt;
-  return MatchInput{points_near(reported.x, reported.y, config_.matching->target_radius_m),
+  return MatchInput{points_near(reported.x, reported.y, config_.matching->target_radius_m,
+                                /*anchored_only=*/true),
                     *config_.matching};
 }
 
@@ -47,14 +48,16 @@ std::shared_ptr<const PointCloud> MissionPipeline::to_map_frame(const PointCloud
   return std::make_shared<const PointCloud>(std::move(in_map));
 }
 
-std::shared_ptr<const PointCloud> MissionPipeline::add(const PointCloud& scan, const Pose& placed) {
-  add(scan, placed, to_map_frame(scan, placed));
+std::shared_ptr<const PointCloud> MissionPipeline::add(const PointCloud& scan, const Pose& placed,
+                                                       bool matched) {
+  add(scan, placed, matched, to_map_frame(scan, placed));
   return placed_.back();
 }
 
-void MissionPipeline::add(const PointCloud& scan, const Pose& placed,
+void MissionPipeline::add(const PointCloud& scan, const Pose& placed, bool matched,
                           std::shared_ptr<const PointCloud> in_map) {
   mapping_.add_scan(scan, placed);
+  anchored_.push_back(placed_.empty() || matched ? 1 : 0);
   placed_.push_back(std::move(in_map));
 }
 
@@ -82,12 +85,14 @@ void MissionPipeline::set_target(TargetRegion target) {
   mapping_.set_target(std::move(target));
 }
 
-PointCloud MissionPipeline::points_near(double x, double y, double radius_m) const {
+PointCloud MissionPipeline::points_near(double x, double y, double radius_m,
+                                        bool anchored_only) const {
   PointCloud out;
   const Eigen::Vector2f c(static_cast<float>(x), static_cast<float>(y));
   const float r2 = static_cast<float>(radius_m * radius_m);
-  for (const auto& part : placed_) {
-    for (const auto& p : part->points) {
+  for (std::size_t i = 0; i < placed_.size(); ++i) {
+    if (anchored_only && !anchored_[i]) continue;
+    for (const auto& p : placed_[i]->points) {
       if ((p.head<2>() - c).squaredNorm() <= r2) out.points.push_back(p);
     }
   }

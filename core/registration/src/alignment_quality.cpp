@@ -38,14 +38,27 @@ bool surface_normal(const detail::PointKdTree& tree, const Eigen::Vector3f& q, f
 
 }  // namespace
 
+AlignmentJudge::AlignmentJudge(const PointCloud& target)
+    : target_(target), tree_(std::make_unique<detail::PointKdTree>(target.points)) {}
+
+AlignmentJudge::~AlignmentJudge() = default;
+
 AlignmentQuality evaluate_alignment(const PointCloud& target, const PointCloud& source,
                                     const Eigen::Isometry3d& source_to_target, Dof dof,
                                     double score_max_distance_m, double inlier_distance_m,
                                     bool with_constraint) {
+  return AlignmentJudge(target).evaluate(source, source_to_target, dof, score_max_distance_m,
+                                         inlier_distance_m, with_constraint);
+}
+
+AlignmentQuality AlignmentJudge::evaluate(const PointCloud& source,
+                                          const Eigen::Isometry3d& source_to_target, Dof dof,
+                                          double score_max_distance_m, double inlier_distance_m,
+                                          bool with_constraint) const {
   AlignmentQuality q;
   q.points = source.size();
-  if (target.empty() || source.empty()) return q;
-  const detail::PointKdTree tree(target.points);
+  if (target_.empty() || source.empty()) return q;
+  const detail::PointKdTree& tree = *tree_;
   const Eigen::Isometry3f T = source_to_target.cast<float>();
   const double cut_sq = score_max_distance_m * score_max_distance_m;
   const double inlier_sq = inlier_distance_m * inlier_distance_m;

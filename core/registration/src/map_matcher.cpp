@@ -8,6 +8,7 @@ MapMatch match_to_map(const PointCloud& map_points, const PointCloud& scan, cons
                       const MapMatchConfig& config) {
   MapMatch out;
   out.placed = reported;
+  out.proposed = reported;
   // The levelled frame: at the reported position, turned by the reported yaw, z vertical.
   Pose level_pose;
   level_pose.x = reported.x;
@@ -24,11 +25,13 @@ MapMatch match_to_map(const PointCloud& map_points, const PointCloud& scan, cons
     if ((p.head<2>() - center).squaredNorm() <= r2) target.points.push_back(level_from_map * p);
   }
   const Eigen::Isometry3d initial = map_from_level.inverse() * reported.isometry();
-  out.result = register_scans(target, scan, initial, config.method, config.registration);
+  RegistrationConfig sized = adapted_config(scan, config.registration);
+  sized.adapt_to_scene = false;
+  out.result = register_scans(target, scan, initial, config.method, sized);
+  const Pose corrected = Pose::from_isometry(map_from_level * out.result.transform);
+  if (out.result.iterations > 0) out.proposed = corrected;
   if (!out.result.converged) return out;
 
-  const Eigen::Isometry3d placed = map_from_level * out.result.transform;
-  const Pose corrected = Pose::from_isometry(placed);
   const double shift = std::hypot(std::hypot(corrected.x - reported.x, corrected.y - reported.y),
                                   corrected.z - reported.z);
   const double turn = std::abs(std::remainder(corrected.yaw - reported.yaw, 2 * M_PI));

@@ -4,10 +4,12 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "pose_increment.hpp"
 #include "scanplan/geometry/voxel_filter.hpp"
 #include "scanplan/registration/alignment_quality.hpp"
 #include "scanplan/registration/ndt_icp.hpp"
@@ -15,23 +17,79 @@
 namespace scanplan {
 namespace {
 
-constexpr std::array<std::pair<Method, std::string_view>, 3> kNames{{
+using detail::metres;
+
+constexpr std::array<std::pair<Method, std::string_view>, 5> kNames{{
     {Method::kNdtIcp, "ndt-icp"},
     {Method::kNdt, "ndt"},
     {Method::kIcp, "icp"},
+    {Method::kGicp, "gicp"},
+    {Method::kSearchGicp, "search-gicp"},
 }};
-
-std::string metres(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g m", v);
-  return buf;
-}
 
 RegistrationResult failed(std::string_view method, std::string message) {
   RegistrationResult r;
   r.method = std::string(method);
   r.message = std::move(message);
   return r;
+}
+
+// Why a settled result is not believed (RegistrationConfig's sanity check), or nothing.
+std::optional<std::string> rejection(const AlignmentQuality& q, const RegistrationConfig& c) {
+  char buf[96];
+  if (q.inlier_ratio < c.min_inlier_ratio) {
+    std::snprintf(buf, sizeof buf, "%.1f%% (at least %.1f%% needed)", 100 * q.inlier_ratio,
+                  100 * c.min_inlier_ratio);
+    return "only " + std::string(buf) + " of the source points lie within " +
+           metres(c.inlier_distance_m) +
+           " of the target: the scans do not overlap enough, or the match is wrong";
+  }
+  const double min_constraint = c.dof == Dof::k4 ? c.min_constraint : c.min_constraint_6dof;
+  if (q.weakest_constraint < min_constraint) {
+    std::snprintf(buf, sizeof buf, "%.4f (at least %.4f needed)", q.weakest_constraint,
+                  min_constraint);
+    return std::string(
+               "the matched surfaces leave the pose nearly free in one direction "
+               "(weakest constraint ") +
+           buf + "): a corridor or a single wall, along which the match cannot be trusted";
+  }
+  return std::nullopt;
+}
+
+// GICP from the peaks of the pose search, best first (from `initial` when the search finds
+// none), until a result passes the sanity check; if none does, the one that came closest. A
+// search peak can be a false one (a facade shifted along itself, a repeated row of cars); the
+// check, not the search score, tells which refinement to believe.
+RegistrationResult align_search_gicp(const PointCloud& target, const PointCloud& source,
+                                     const Eigen::Isometry3d& initial,
+                                     const RegistrationConfig& c) {
+  const GicpMatcher gicp(target, source, c.gicp);
+  const AlignmentJudge judge(target);
+  // Which result to keep is judged on every third source point, a third of the cost; the kept
+  // one is judged again on all of them (register_with).
+  PointCloud sample;
+  for (std::size_t i = 0; i < source.size(); i += 3) sample.points.push_back(source.points[i]);
+  std::vector<PoseHypothesis> starts = search_poses(target, source, initial, c.search);
+  if (starts.empty()) starts.push_back({initial, 0});
+  RegistrationResult best;
+  int best_rank = -1;
+  std::size_t best_inliers = 0;
+  int iterations = 0;
+  for (const PoseHypothesis& start : starts) {
+    RegistrationResult r = gicp.align(start.transform, c.dof);
+    iterations += r.iterations;
+    const AlignmentQuality q = judge.evaluate(sample, r.transform, c.dof, c.score_max_distance_m,
+                                              c.inlier_distance_m, r.converged);
+    const int rank = r.converged ? (rejection(q, c) ? 1 : 2) : 0;
+    if (rank > best_rank || (rank == best_rank && q.inliers > best_inliers)) {
+      best = std::move(r);
+      best_rank = rank;
+      best_inliers = q.inliers;
+    }
+    if (best_rank == 2) break;
+  }
+  best.iterations = iterations;
+  return best;
 }
 
 RegistrationResult align_ours(const PointCloud& target, const PointCloud& source,
@@ -44,6 +102,10 @@ RegistrationResult align_ours(const PointCloud& target, const PointCloud& source
       return align_narrower_ndt(target, source, initial, c.dof, c.ndt);
     case Method::kIcp:
       return align_line_segment_icp(target, source, initial, c.dof, c.icp);
+    case Method::kGicp:
+      return align_gicp(target, source, initial, c.dof, c.gicp);
+    case Method::kSearchGicp:
+      return align_search_gicp(target, source, initial, c);
   }
   return failed(method_name(method), "unknown method");
 }
@@ -85,6 +147,13 @@ RegistrationConfig scale_lengths(const RegistrationConfig& config, double factor
   c.icp.source_voxel_m *= factor;
   c.icp.translation_tolerance_m *= factor;
   c.score_max_distance_m *= factor;
+  for (GicpStage& stage : c.gicp.stages) {
+    stage.voxel_m *= factor;
+    stage.max_correspondence_m *= factor;
+  }
+  c.gicp.translation_tolerance_m *= factor;
+  c.search.cell_m *= factor;
+  c.search.source_voxel_m *= factor;
   c.inlier_distance_m *= factor;
   // NDT's tolerances and step bounds are already relative to the cell size.
   return c;
@@ -156,22 +225,11 @@ RegistrationResult register_with(const PointCloud& target, const PointCloud& sou
   r.score = q.score;
   r.rmse = q.rmse;
   r.inlier_ratio = q.inlier_ratio;
-  if (r.converged && q.inlier_ratio < c.min_inlier_ratio) {
-    r.converged = false;
-    r.message = "only " + std::to_string(static_cast<int>(q.inlier_ratio * 100 + 0.5)) +
-                "% of the source points lie within " + metres(c.inlier_distance_m) +
-                " of the target (at least " +
-                std::to_string(static_cast<int>(c.min_inlier_ratio * 100 + 0.5)) +
-                "% needed): the scans do not overlap enough, or the match is wrong";
-  } else if (r.converged && q.weakest_constraint < c.min_constraint) {
-    r.converged = false;
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.4f (at least %.4f needed)", q.weakest_constraint,
-                  c.min_constraint);
-    r.message = std::string(
-                    "the matched surfaces leave the pose nearly free in one direction "
-                    "(weakest constraint ") +
-                buf + "): a corridor or a single wall, along which the match cannot be trusted";
+  if (r.converged) {
+    if (std::optional<std::string> why = rejection(q, c)) {
+      r.converged = false;
+      r.message = std::move(*why);
+    }
   }
   return r;
 }

@@ -55,6 +55,19 @@ TEST_F(MapMatcher, PlacesAScanReportedOffOnItsTruePose) {
   EXPECT_NEAR(m.placed.pitch, reported.pitch, 1e-9);
 }
 
+TEST_F(MapMatcher, PlacesAScanReportedAsFarOffAsThePoseSensorsCanErr) {
+  // 3σ of the benchmark's sensors in x-y and yaw at once: beyond a local method's basin.
+  Pose reported = truth_;
+  reported.x += 4.0;
+  reported.y -= 3.0;
+  reported.yaw -= deg2rad(20);
+  const MapMatch m = match_to_map(map_, scan_, reported, quick());
+  ASSERT_TRUE(m.applied) << m.result.message;
+  EXPECT_EQ(m.result.method, "search-gicp");
+  EXPECT_LT(metres_between(m.placed, truth_), 0.03);
+  EXPECT_LT(degrees_between(m.placed.yaw, truth_.yaw), 0.1);
+}
+
 TEST_F(MapMatcher, ACorrectionLargerThanTheSensorsCanErrIsNotApplied) {
   Pose reported = truth_;
   reported.x += 0.8;

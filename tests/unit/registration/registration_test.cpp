@@ -40,8 +40,11 @@ RegistrationConfig fast_config(Dof dof) {
 // ---------------------------------------------------------------------------------------------
 // Known transforms on the synthetic yard: every method × 4/6 DOF.
 
-const std::vector<AnyMethod> kAllMethods{Method::kNdtIcp, Method::kNdt,    Method::kIcp,
-                                         PclMethod::kNdt, PclMethod::kIcp, PclMethod::kGicp};
+const std::vector<AnyMethod> kAllMethods{Method::kNdtIcp, Method::kNdt,        Method::kIcp,
+                                         Method::kGicp,   Method::kSearchGicp, PclMethod::kNdt,
+                                         PclMethod::kIcp, PclMethod::kGicp};
+const std::vector<Method> kOurMethods{Method::kNdtIcp, Method::kNdt, Method::kIcp, Method::kGicp,
+                                      Method::kSearchGicp};
 
 struct Tolerance {
   double metres, degrees;
@@ -51,6 +54,7 @@ struct Tolerance {
 // single-resolution NDT are less exact on thinned clouds.
 Tolerance tolerance_of(AnyMethod m) {
   if (m == AnyMethod{Method::kNdtIcp} || m == AnyMethod{Method::kIcp}) return {0.02, 0.1};
+  if (m == AnyMethod{Method::kGicp} || m == AnyMethod{Method::kSearchGicp}) return {0.01, 0.05};
   if (m == AnyMethod{Method::kNdt}) return {0.05, 0.2};
   if (m == AnyMethod{PclMethod::kGicp}) return {0.03, 0.15};
   return {0.08, 0.3};  // PCL's NDT and ICP
@@ -158,7 +162,8 @@ TEST_P(SimulatedPair, MatchesTwoScansOfTheYard) {
 }
 
 INSTANTIATE_TEST_SUITE_P(OurMethods, SimulatedPair,
-                         ::testing::Combine(::testing::Values(Method::kNdtIcp, Method::kNdt),
+                         ::testing::Combine(::testing::Values(Method::kNdtIcp, Method::kNdt,
+                                                              Method::kGicp, Method::kSearchGicp),
                                             ::testing::Values(Dof::k4, Dof::k6)),
                          [](const auto& param_info) {
                            std::string name(method_name(std::get<0>(param_info.param)));
@@ -176,7 +181,7 @@ TEST(Registration, FourDofNeverChangesRollOrPitch) {
   const PointCloud source = moved(synthetic_yard(4, 20000), truth.isometry().inverse());
   // A start with roll and pitch that the truth does not have: 4 DOF must keep them regardless.
   const Pose start = pose(0.6, 0.9, 0.2, 3, 2.5, -1.5);
-  for (Method m : {Method::kNdtIcp, Method::kNdt, Method::kIcp}) {
+  for (Method m : kOurMethods) {
     const RegistrationResult r =
         register_scans(target, source, start.isometry(), m, fast_config(Dof::k4));
     const Pose got = Pose::from_isometry(r.transform);
@@ -260,14 +265,12 @@ TEST(Registration, CorridorIsNotReportedAsConverged) {
 
 TEST(Registration, MethodNamesRoundTrip) {
   for (AnyMethod m : kAllMethods) EXPECT_EQ(parse_any_method(any_method_name(m)), m);
-  for (Method m : {Method::kNdtIcp, Method::kNdt, Method::kIcp}) {
-    EXPECT_EQ(parse_method(method_name(m)), m);
-  }
+  for (Method m : kOurMethods) EXPECT_EQ(parse_method(method_name(m)), m);
   EXPECT_EQ(parse_method("ndt-icp"), Method::kNdtIcp);
   EXPECT_FALSE(parse_method("pcl-ndt")) << "the baselines are not ours";
   EXPECT_FALSE(parse_any_method("NDT"));
   EXPECT_FALSE(parse_any_method(""));
-  EXPECT_FALSE(parse_any_method("gicp"));
+  EXPECT_EQ(parse_any_method("gicp"), AnyMethod{Method::kGicp}) << "ours; PCL's is pcl-gicp";
 }
 
 TEST(VoxelFilter, KeepsOneMeasuredPointPerVoxel) {

@@ -30,6 +30,9 @@ struct LoopStep {
   Pose placed_pose;    // where the map put the scan (matched when matching is on)
   std::optional<RegistrationResult> match;  // when the scan was matched against the map
   bool match_applied = false;               // whether placed_pose is the match's correction
+  // How far the match's result was from the truth (relative to the first scan), applied or
+  // not: a refused match that was right, or an applied one that was wrong, shows here.
+  std::optional<double> match_error_m, match_error_deg;
   // How far placed_pose is from the truth, relative to the first scan (which defines the map
   // frame): what a rescue crew reading the map would be misled by.
   double placed_error_m = 0;

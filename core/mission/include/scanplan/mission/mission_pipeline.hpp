@@ -34,9 +34,11 @@ class MissionPipeline {
  public:
   explicit MissionPipeline(MissionConfig config = {});
 
-  // Placed: where scan `scan` (its own frame) goes, matched against the map's points near
-  // `reported` (MapMatchConfig::target_radius_m). Nothing when matching is off or the map is
-  // still empty (the first scan defines the map frame). Changes nothing.
+  // Placed: where scan `scan` (its own frame) goes, matched against the points near `reported`
+  // (MapMatchConfig::target_radius_m) of the anchored scans: the first, which defines the map
+  // frame, and those placed by a match the sanity check believed. A scan left at its reported
+  // pose is metres off as often as not; matched against, it would pull every later scan near
+  // it off with it. Nothing when matching is off or nothing is anchored yet. Changes nothing.
   std::optional<MapMatch> place(const PointCloud& scan, const Pose& reported) const;
   // place() in two steps, for an owner that matches without holding its lock: what the match
   // needs from the map (nothing when there is nothing to match against), then match_to_map.
@@ -46,11 +48,13 @@ class MissionPipeline {
   };
   std::optional<MatchInput> match_input(const Pose& reported) const;
 
-  // Mapped and segmented: the scan joins the map at `placed`. Returns its points in the map
-  // frame (coloured; grey where the scan had no colour), shared, never copied again.
-  std::shared_ptr<const PointCloud> add(const PointCloud& scan, const Pose& placed);
+  // Mapped and segmented: the scan joins the map at `placed`; `matched` when a believed match
+  // placed it (see place(); the first scan is anchored regardless). Returns its points in the
+  // map frame (coloured; grey where the scan had no colour), shared, never copied again.
+  std::shared_ptr<const PointCloud> add(const PointCloud& scan, const Pose& placed, bool matched);
   // The same with the points in the map frame already made (to_map_frame).
-  void add(const PointCloud& scan, const Pose& placed, std::shared_ptr<const PointCloud> in_map);
+  void add(const PointCloud& scan, const Pose& placed, bool matched,
+           std::shared_ptr<const PointCloud> in_map);
   static std::shared_ptr<const PointCloud> to_map_frame(const PointCloud& scan, const Pose& placed);
 
   // Planned: the next scan point for each robot (plan_fleet, PlanInput::claimed for `claimed`,
@@ -64,8 +68,11 @@ class MissionPipeline {
   void set_planner(const PlannerConfig& planner);
   void set_target(TargetRegion target);
 
-  // The map's points (map frame) within `radius_m` of (x, y) in the x-y plane.
-  PointCloud points_near(double x, double y, double radius_m) const;
+  // The map's points (map frame) within `radius_m` of (x, y) in the x-y plane; only the
+  // anchored scans' when `anchored_only`.
+  PointCloud points_near(double x, double y, double radius_m, bool anchored_only = false) const;
+  // Whether the i-th scan (in the order they joined) is anchored (see place()).
+  bool anchored(std::size_t i) const { return anchored_.at(i) != 0; }
   // Each scan's points in the map frame, in the order they joined.
   const std::vector<std::shared_ptr<const PointCloud>>& placed_scans() const { return placed_; }
   const MappingPipeline& mapping() const { return mapping_; }
@@ -78,6 +85,7 @@ class MissionPipeline {
   MissionConfig config_;
   MappingPipeline mapping_;
   std::vector<std::shared_ptr<const PointCloud>> placed_;
+  std::vector<std::uint8_t> anchored_;  // per entry of placed_
 };
 
 }  // namespace scanplan

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cstddef>
+#include <memory>
 
 #include "scanplan/geometry/point_cloud.hpp"
 #include "scanplan/registration/registration_result.hpp"
@@ -25,6 +26,28 @@ struct AlignmentQuality {
   // constrain that direction: near 0 in a corridor (nothing stops sliding along it) or on open
   // ground, a few per cent and more where walls face several ways.
   double weakest_constraint = 0;
+};
+
+namespace detail {
+class PointKdTree;
+}
+
+// evaluate_alignment with the target's k-d tree built once, for judging several results
+// against the same target (search-gicp's hypotheses). Keeps a reference to `target`.
+class AlignmentJudge {
+ public:
+  explicit AlignmentJudge(const PointCloud& target);
+  ~AlignmentJudge();
+  AlignmentJudge(const AlignmentJudge&) = delete;
+  AlignmentJudge& operator=(const AlignmentJudge&) = delete;
+
+  AlignmentQuality evaluate(const PointCloud& source, const Eigen::Isometry3d& source_to_target,
+                            Dof dof, double score_max_distance_m, double inlier_distance_m,
+                            bool with_constraint = true) const;
+
+ private:
+  const PointCloud& target_;
+  std::unique_ptr<detail::PointKdTree> tree_;
 };
 
 // Scores `source` moved by `source_to_target` against `target`. The paper does not say how

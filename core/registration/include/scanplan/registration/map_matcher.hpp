@@ -6,7 +6,11 @@
 namespace scanplan {
 
 struct MapMatchConfig {
-  Method method = Method::kNdtIcp;  // paper §4.3: narrower NDT, then line-segment ICP
+  // Beyond the paper (§4.3 uses NDT then line-segment ICP, still selectable): scans the
+  // planner places 30–40 m apart need the wide basin of a search and GICP's accuracy.
+  Method method = Method::kSearchGicp;
+  // Its lengths are fitted to the new scan's range (adapt_to_scene), not to the map's: the map
+  // around the scan reaches target_radius_m whatever the scanner saw.
   RegistrationConfig registration;
   // Map points farther than this from the reported position cannot overlap the new scan much,
   // and only slow the match down.
@@ -19,6 +23,9 @@ struct MapMatchConfig {
 
 struct MapMatch {
   Pose placed;  // where the scan goes in the map: corrected, or the reported pose on failure
+  // Where the matcher's result would put the scan, applied or not (the reported pose when no
+  // alignment ran): what a refused match proposed, for whoever studies the refusals.
+  Pose proposed;
   RegistrationResult result;
   bool applied = false;  // whether `placed` is the matcher's correction
 };

@@ -1,0 +1,205 @@
+#include "scanplan/registration/gicp.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "point_kdtree.hpp"
+#include "pose_increment.hpp"
+#include "scanplan/geometry/voxel_filter.hpp"
+
+namespace scanplan {
+
+using detail::Mat;
+using detail::metres;
+using detail::Vec;
+
+namespace {
+
+// Neighbours a point's covariance is taken over (Segal et al. and small_gicp use 10–20).
+constexpr int kNeighbours = 10;
+
+// A cloud with its k-d tree and each point's neighbourhood covariance, flattened to a plane
+// (GicpConfig::plane_epsilon). The covariances are computed when first asked for: at the
+// planner's spacing most points of either scan never find a partner, and the neighbour search
+// behind a covariance is the largest single cost of GICP.
+class CovariedCloud {
+ public:
+  CovariedCloud(PointCloud cloud, float neighbour_radius, double epsilon)
+      : cloud_(std::move(cloud)),
+        tree_(cloud_.points),
+        radius_sq_(neighbour_radius * neighbour_radius),
+        epsilon_(epsilon),
+        cov_(cloud_.size()),
+        known_(cloud_.size(), 0) {}
+
+  const detail::PointKdTree& tree() const { return tree_; }
+  const PointCloud& cloud() const { return cloud_; }
+  std::size_t size() const { return cloud_.size(); }
+
+  // A point with too few neighbours for a plane gets an isotropic covariance: it still
+  // attracts, but weakly in every direction.
+  const Eigen::Matrix3d& covariance(std::uint32_t i) const {
+    if (!known_[i]) {
+      cov_[i] = plane_covariance(cloud_.points[i]);
+      known_[i] = 1;
+    }
+    return cov_[i];
+  }
+
+ private:
+  Eigen::Matrix3d plane_covariance(const Eigen::Vector3f& q) const {
+    std::uint32_t index[kNeighbours];
+    float sq[kNeighbours];
+    const int n = tree_.nearest<kNeighbours>(q, radius_sq_, index, sq);
+    if (n < 5) return Eigen::Matrix3d::Identity();
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int j = 0; j < n; ++j) mean += tree_.point(index[j]).cast<double>();
+    mean /= n;
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (int j = 0; j < n; ++j) {
+      const Eigen::Vector3d d = tree_.point(index[j]).cast<double>() - mean;
+      cov += d * d.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+    eig.computeDirect(cov);
+    const Eigen::Vector3d values(epsilon_, 1.0, 1.0);
+    return eig.eigenvectors() * values.asDiagonal() * eig.eigenvectors().transpose();
+  }
+
+  PointCloud cloud_;
+  detail::PointKdTree tree_;  // over cloud_.points, which never move
+  float radius_sq_;
+  double epsilon_;
+  mutable std::vector<Eigen::Matrix3d> cov_;
+  mutable std::vector<std::uint8_t> known_;
+};
+
+}  // namespace
+
+struct GicpMatcher::Stage {
+  Stage(const GicpStage& l, PointCloud target_points, PointCloud source_points, double epsilon)
+      : lengths(l),
+        // Neighbours farther than a correspondence may reach do not describe the surface there.
+        target(std::move(target_points), static_cast<float>(l.max_correspondence_m), epsilon),
+        source(std::move(source_points), static_cast<float>(l.max_correspondence_m), epsilon) {}
+  GicpStage lengths;
+  CovariedCloud target, source;
+};
+
+namespace {
+
+template <int N>
+struct Linearised {
+  Mat<N> H = Mat<N>::Zero();
+  Vec<N> g = Vec<N>::Zero();
+  double error = 0;
+  int matches = 0;
+};
+
+// The Mahalanobis residuals d = q − T·p under (C_q + R·C_p·Rᵀ)⁻¹, linearised at T for the left
+// increment of pose_increment.hpp.
+template <int N>
+Linearised<N> linearise(const GicpMatcher::Stage& s, const Eigen::Isometry3d& T) {
+  Linearised<N> out;
+  const float max_sq =
+      static_cast<float>(s.lengths.max_correspondence_m * s.lengths.max_correspondence_m);
+  const Eigen::Matrix3d R = T.linear();
+  const std::vector<Eigen::Vector3f>& source = s.source.cloud().points;
+  for (std::uint32_t i = 0; i < source.size(); ++i) {
+    const Eigen::Vector3d p = T * source[i].cast<double>();
+    std::uint32_t index[1];
+    float sq[1];
+    if (s.target.tree().nearest<1>(p.cast<float>(), max_sq, index, sq) == 0) continue;
+    const Eigen::Vector3d d = s.target.cloud().points[index[0]].cast<double>() - p;
+    const Eigen::Matrix3d C =
+        s.target.covariance(index[0]) + R * s.source.covariance(i) * R.transpose();
+    const Eigen::Matrix3d W = C.inverse();
+    // d(d)/dθ = −dp/dθ.
+    const Eigen::Matrix<double, 3, N> J = -detail::point_jacobian<N>(p);
+    const Eigen::Matrix<double, N, 3> JtW = J.transpose() * W;
+    out.H.noalias() += JtW * J;
+    out.g.noalias() += JtW * d;
+    out.error += d.dot(W * d);
+    ++out.matches;
+  }
+  return out;
+}
+
+}  // namespace
+
+GicpMatcher::GicpMatcher(const PointCloud& target, const PointCloud& source,
+                         const GicpConfig& config)
+    : config_(config) {
+  stages_.reserve(config.stages.size());
+  for (const GicpStage& lengths : config.stages) {
+    const double source_voxel = std::max(lengths.voxel_m, lengths.source_voxel_m);
+    stages_.push_back(std::make_unique<Stage>(
+        lengths, lengths.voxel_m > 0 ? voxel_downsample(target, lengths.voxel_m) : target,
+        source_voxel > 0 ? voxel_downsample(source, source_voxel) : source, config.plane_epsilon));
+  }
+}
+
+GicpMatcher::~GicpMatcher() = default;
+
+RegistrationResult GicpMatcher::align(const Eigen::Isometry3d& initial, Dof dof) const {
+  return detail::with_dof(dof, [&]<int N>() {
+    RegistrationResult r;
+    r.method = "gicp";
+    r.transform = initial;
+    if (stages_.empty()) {
+      r.message = "no GICP stage configured";
+      return r;
+    }
+    for (std::size_t k = 0; k < stages_.size(); ++k) {
+      const Stage& s = *stages_[k];
+      bool settled = false;
+      for (int it = 0; it < config_.max_iterations_per_stage; ++it) {
+        const Linearised<N> lin = linearise<N>(s, r.transform);
+        ++r.iterations;
+        if (lin.matches < config_.min_correspondences) {
+          r.message = "only " + std::to_string(lin.matches) +
+                      " source points have a target point within " +
+                      metres(s.lengths.max_correspondence_m) +
+                      ": the clouds do not overlap from this start";
+          return r;
+        }
+        // A whisper of damping keeps a direction nothing constrains (open ground) from
+        // producing an unbounded step.
+        Mat<N> H = lin.H;
+        H.diagonal().array() += 1e-6 * H.trace() / N;
+        const Vec<N> delta = H.ldlt().solve(-lin.g);
+        if (!delta.allFinite()) {
+          r.message = "the GICP step is not finite";
+          return r;
+        }
+        r.transform = detail::apply_increment<N>(r.transform, delta);
+        const auto [moved, turned] = detail::step_size<N>(delta);
+        if (moved < config_.translation_tolerance_m && turned < config_.rotation_tolerance_rad) {
+          settled = true;
+          break;
+        }
+      }
+      // Only the last stage's ending says whether the match converged: a coarse stage that
+      // runs out of iterations has still brought the source close enough for the next.
+      if (k + 1 == stages_.size()) {
+        r.converged = settled;
+        if (!settled) {
+          r.message = "GICP did not settle within " +
+                      std::to_string(config_.max_iterations_per_stage) + " iterations";
+        }
+      }
+    }
+    return r;
+  });
+}
+
+RegistrationResult align_gicp(const PointCloud& target, const PointCloud& source,
+                              const Eigen::Isometry3d& initial, Dof dof, const GicpConfig& config) {
+  return GicpMatcher(target, source, config).align(initial, dof);
+}
+
+}  // namespace scanplan
