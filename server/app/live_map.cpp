@@ -74,7 +74,7 @@ std::optional<MapMatch> LiveMap::place(const PointCloud& scan, const Pose& repor
     in = mission_.match_input(reported);
   }
   if (!in) return std::nullopt;
-  return match_to_map(in->map_points, scan, reported, in->config);
+  return match_to_map(in->map_points, scan, in->prior, in->config);
 }
 
 std::vector<PlanRecord> LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
@@ -88,7 +88,7 @@ std::vector<PlanRecord> LiveMap::add(const StoredScan& scan, const PointCloud& c
   // Writers take turns on encode_mutex_; readers only wait for the short commit below, and
   // they see the scan, its points, its chunk and the plan that includes it appear together.
   std::lock_guard encode_lock(encode_mutex_);
-  mission_.add(cloud, pose, scan.match && scan.match->applied, shared);
+  mission_.add(cloud, {scan.estimated, pose, scan.match && scan.match->applied}, shared);
   thinned_.add(*shared);
   last_scan_ = {scan.id, scan.robot};
   scan_pose_of_[scan.robot] = pose;

@@ -73,11 +73,13 @@ StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
   scan.match = StoredMatch{m.applied,        m.result.converged,
                            m.result.method,  m.applied ? std::string() : m.result.message,
                            m.result.time_ms, m.result.inlier_ratio};
-  if (m.applied) scan.placed = p;
+  // Refused, the match leaves the scan at its reported pose carried into the map frame.
+  scan.placed = p;
   session_.record_match(scan.id, *scan.match, p);
   events_.publish("match_done", match_done_json(scan.id, e, m));
   if (!m.applied) {
-    spdlog::warn("scan {} stays at its reported pose: {}", scan.id, m.result.message);
+    spdlog::warn("scan {} stays at its reported pose (in the map frame): {}", scan.id,
+                 m.result.message);
     return scan;
   }
   spdlog::info("scan {} matched ({}): moved {:.2f} m, {:.2f}°, score {:.1f}, {:.0f} ms", scan.id,

@@ -49,8 +49,9 @@ PointCloud read_scan(const std::string& file, const char* role, const RegisterAr
 void run_register(const RegisterArgs& a) {
   const std::optional<AnyMethod> method = parse_any_method(a.method);
   if (!method) {
-    throw std::runtime_error("--method " + a.method +
-                             ": expected ndt-icp, ndt, icp, pcl-ndt, pcl-icp or pcl-gicp");
+    throw std::runtime_error(
+        "--method " + a.method +
+        ": expected ndt-icp, ndt, icp, gicp, search-gicp, pcl-ndt, pcl-icp or pcl-gicp");
   }
   const PointCloud target = read_scan(a.target, "target", a);
   const PointCloud source = read_scan(a.source, "source", a);
@@ -103,7 +104,8 @@ void add_register_command(CLI::App& app) {
                   "initial guess of the transform source -> target: x,y,z,yaw_deg (default 0)")
       ->delimiter(',')
       ->expected(4);
-  cmd->add_option("--method", args->method, "ndt-icp | ndt | icp | pcl-ndt | pcl-icp | pcl-gicp")
+  cmd->add_option("--method", args->method,
+                  "ndt-icp | ndt | icp | gicp | search-gicp | pcl-ndt | pcl-icp | pcl-gicp")
       ->capture_default_str();
   cmd->add_option("--dof", args->dof,
                   "4: x, y, z, yaw (roll and pitch kept from --init); 6: all six")

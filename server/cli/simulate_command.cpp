@@ -84,6 +84,7 @@ nlohmann::json scan_json(const LoopStep& s, const LoopStep& first) {
       match["error_m"] = *s.match_error_m;
       match["error_deg"] = *s.match_error_deg;
     }
+    if (s.match_proposed) match["proposed"] = pose_json(*s.match_proposed);
   }
   return {{"scan", s.scan},
           {"reported", pose_json(s.reported_pose)},

@@ -232,13 +232,11 @@ void SessionStore::record_match(std::int64_t id, const StoredMatch& m, const Pos
     ins.bind(1, id).bind(2, std::int64_t{m.applied}).bind(3, std::int64_t{m.converged});
     ins.bind(4, m.method).bind(5, m.reason).bind(6, m.time_ms).bind(7, m.inlier_ratio);
     ins.step();
-    if (m.applied) {
-      Statement s(
-          db_, "UPDATE scans SET x = ?, y = ?, z = ?, roll = ?, pitch = ?, yaw = ? WHERE id = ?");
-      s.bind(1, p.x).bind(2, p.y).bind(3, p.z).bind(4, p.roll).bind(5, p.pitch).bind(6, p.yaw);
-      s.bind(7, id);
-      s.step();
-    }
+    Statement s(db_,
+                "UPDATE scans SET x = ?, y = ?, z = ?, roll = ?, pitch = ?, yaw = ? WHERE id = ?");
+    s.bind(1, p.x).bind(2, p.y).bind(3, p.z).bind(4, p.roll).bind(5, p.pitch).bind(6, p.yaw);
+    s.bind(7, id);
+    s.step();
     exec("COMMIT");
   } catch (...) {
     exec("ROLLBACK");

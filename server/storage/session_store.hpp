@@ -88,8 +88,9 @@ class SessionStore {
   // `cloud` in the scan's own frame. Returns the new scan with its id.
   StoredScan add_scan(const std::string& robot, const Pose& estimated, const Pose& placed,
                       std::int64_t stamp_ns, const PointCloud& cloud);
-  // Records how matching went for scan `id` and, when it was applied, where it placed the
-  // scan: both in one transaction.
+  // Records how matching went for scan `id` and where the scan was placed (the match's
+  // correction, or the reported pose carried into the map frame when it was refused): both in
+  // one transaction.
   void record_match(std::int64_t id, const StoredMatch& match, const Pose& placed);
   std::vector<StoredScan> scans() const;
   // The newest `limit` events recorded with append_event, oldest first.

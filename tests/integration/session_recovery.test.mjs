@@ -64,6 +64,14 @@ test('acknowledged scans survive SIGKILL', async () => {
     return s.scans === 3 ? s : undefined;
   });
   const mapBefore = Buffer.from(await (await stack.api('GET', '/api/v1/map.drc')).arrayBuffer());
+  // Each scan after the first carries its match outcome, stored with it.
+  const listBefore = (await (await stack.api('GET', '/api/v1/scans')).json()).scans;
+  assert.equal(listBefore[0].match, null, 'the first scan defines the map frame');
+  for (const s of listBefore.slice(1)) {
+    assert.equal(s.match.method, 'search-gicp');
+    assert.equal(typeof s.match.applied, 'boolean');
+    assert.equal(s.match.reason === '', s.match.applied, 'a reason exactly when not applied');
+  }
   // Annotations: one withdrawn, and one acknowledged just before the kill.
   const annotate = async (body) => {
     const r = await stack.api('POST', '/api/v1/annotations', { body: JSON.stringify(body) });
@@ -87,6 +95,7 @@ test('acknowledged scans survive SIGKILL', async () => {
   const list = (await (await stack.api('GET', '/api/v1/scans')).json()).scans;
   assert.deepEqual(list.map((s) => s.id), [1, 2, 3]);
   assert.deepEqual(list[1].estimated, { x: 5, y: -14, z: 0, yaw_deg: 90 });
+  assert.deepEqual(list.map((s) => s.match), listBefore.map((s) => s.match), 'the match outcomes are back');
   const mapAfter = Buffer.from(await (await stack.api('GET', '/api/v1/map.drc')).arrayBuffer());
   assert.ok(mapAfter.equals(mapBefore), 'the page gets the same map after the restart');
   const next = await post(stack, 0);

@@ -77,7 +77,10 @@ LoopResult run_closed_loop(
   const WorldTraversability trav(world, caster);
   Pose truth = trav.standing_pose(world.start.x, world.start.y, world.start.z, world.start.yaw);
 
-  MissionConfig mission_config{config.pipeline, config.planner, config.matching};
+  MissionConfig mission_config{config.pipeline,
+                               config.planner,
+                               config.matching,
+                               {world.pose_noise.xy_sigma_m, world.pose_noise.yaw_sigma_deg}};
   mission_config.mapping.sensor_height_m = world.scanner.mount_height_m;
   MissionPipeline mission(mission_config);
   mission.set_target(world.target_region());
@@ -97,23 +100,22 @@ LoopResult run_closed_loop(
                                            config.seed * 7919 + static_cast<std::uint64_t>(scan));
     step.reported_pose = reported_pose(truth, world.pose_noise, pose_rng);
     step.placed_pose = step.reported_pose;
-    std::optional<Pose> proposed;
     if (const auto m = mission.place(cloud, step.reported_pose)) {
       step.match = m->result;
       step.match_applied = m->applied;
       step.placed_pose = m->placed;
-      proposed = m->proposed;
+      step.match_proposed = m->proposed;
     }
-    mission.add(cloud, step.placed_pose, step.match_applied);
+    mission.add(cloud, {step.reported_pose, step.placed_pose, step.match_applied});
     if (!result.steps.empty()) {
       const LoopStep& first = result.steps.front();
       const PoseError e =
           placed_error(first.placed_pose, first.true_pose, step.placed_pose, step.true_pose);
       step.placed_error_m = e.metres;
       step.placed_error_deg = e.degrees;
-      if (proposed) {
+      if (step.match_proposed) {
         const PoseError m =
-            placed_error(first.placed_pose, first.true_pose, *proposed, step.true_pose);
+            placed_error(first.placed_pose, first.true_pose, *step.match_proposed, step.true_pose);
         step.match_error_m = m.metres;
         step.match_error_deg = m.degrees;
       }

@@ -16,7 +16,8 @@ PipelineConfig with_planner_thresholds(PipelineConfig mapping, const PlannerConf
 
 MissionPipeline::MissionPipeline(MissionConfig config)
     : config_(std::move(config)),
-      mapping_(with_planner_thresholds(config_.mapping, config_.planner)) {}
+      mapping_(with_planner_thresholds(config_.mapping, config_.planner)),
+      sensor_frame_(config_.pose_noise) {}
 
 bool MissionPipeline::has_map() const {
   return mapping_.regions() && mapping_.movable() && mapping_.target();
@@ -25,15 +26,16 @@ bool MissionPipeline::has_map() const {
 std::optional<MissionPipeline::MatchInput> MissionPipeline::match_input(
     const Pose& reported) const {
   if (!config_.matching || placed_.empty()) return std::nullopt;
-  return MatchInput{points_near(reported.x, reported.y, config_.matching->target_radius_m,
-                                /*anchored_only=*/true),
-                    *config_.matching};
+  const Pose start = prior(reported);
+  return MatchInput{
+      points_near(start.x, start.y, config_.matching->target_radius_m, /*anchored_only=*/true),
+      *config_.matching, start};
 }
 
 std::optional<MapMatch> MissionPipeline::place(const PointCloud& scan, const Pose& reported) const {
   const std::optional<MatchInput> in = match_input(reported);
   if (!in) return std::nullopt;
-  return match_to_map(in->map_points, scan, reported, in->config);
+  return match_to_map(in->map_points, scan, in->prior, in->config);
 }
 
 std::shared_ptr<const PointCloud> MissionPipeline::to_map_frame(const PointCloud& scan,
@@ -48,16 +50,18 @@ std::shared_ptr<const PointCloud> MissionPipeline::to_map_frame(const PointCloud
   return std::make_shared<const PointCloud>(std::move(in_map));
 }
 
-std::shared_ptr<const PointCloud> MissionPipeline::add(const PointCloud& scan, const Pose& placed,
-                                                       bool matched) {
-  add(scan, placed, matched, to_map_frame(scan, placed));
+std::shared_ptr<const PointCloud> MissionPipeline::add(const PointCloud& scan,
+                                                       const Placement& where) {
+  add(scan, where, to_map_frame(scan, where.placed));
   return placed_.back();
 }
 
-void MissionPipeline::add(const PointCloud& scan, const Pose& placed, bool matched,
+void MissionPipeline::add(const PointCloud& scan, const Placement& where,
                           std::shared_ptr<const PointCloud> in_map) {
-  mapping_.add_scan(scan, placed);
-  anchored_.push_back(placed_.empty() || matched ? 1 : 0);
+  mapping_.add_scan(scan, where.placed);
+  const bool anchored = placed_.empty() || where.matched;
+  anchored_.push_back(anchored ? 1 : 0);
+  if (anchored) sensor_frame_.add(where.reported, where.placed);
   placed_.push_back(std::move(in_map));
 }
 

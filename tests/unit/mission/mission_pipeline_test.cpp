@@ -50,7 +50,7 @@ TEST_F(MissionPipelineTest, TheFirstScanDefinesTheMapFrameAndIsNotMatched) {
   const PointCloud cloud = scan_at(first, 1);
   EXPECT_FALSE(mission.place(cloud, first)) << "nothing to match against yet";
   EXPECT_FALSE(mission.has_map());
-  const auto placed = mission.add(cloud, first, false);
+  const auto placed = mission.add(cloud, {first, first});
   ASSERT_EQ(placed->size(), cloud.size());
   EXPECT_TRUE(placed->has_colors());
   // Points go into the map frame by the pose.
@@ -64,7 +64,7 @@ TEST_F(MissionPipelineTest, TheFirstScanDefinesTheMapFrameAndIsNotMatched) {
 
 TEST_F(MissionPipelineTest, ASecondScanIsPlacedBackOnItsTruePose) {
   MissionPipeline mission(config());
-  mission.add(scan_at(at(-15, -8, 0), 1), at(-15, -8, 0), false);
+  mission.add(scan_at(at(-15, -8, 0), 1), {at(-15, -8, 0), at(-15, -8, 0)});
   const Pose truth = at(-5, -9, 20);
   Pose reported = truth;
   reported.x += 0.6;
@@ -77,18 +77,18 @@ TEST_F(MissionPipelineTest, ASecondScanIsPlacedBackOnItsTruePose) {
   EXPECT_LT(std::hypot(m->placed.x - truth.x, m->placed.y - truth.y), 0.05);
   EXPECT_LT(std::abs(rad2deg(std::remainder(m->placed.yaw - truth.yaw, 2 * M_PI))), 0.2);
   EXPECT_EQ(mission.placed_scans().size(), 1u) << "placing changes nothing";
-  mission.add(second, m->placed, m->applied);
+  mission.add(second, {reported, m->placed, m->applied});
   EXPECT_EQ(mission.placed_scans().size(), 2u);
 }
 
 TEST_F(MissionPipelineTest, OnlyAnchoredScansAreMatchedAgainst) {
   MissionPipeline mission(config());
-  mission.add(scan_at(at(-15, -8, 0), 1), at(-15, -8, 0), false);
+  mission.add(scan_at(at(-15, -8, 0), 1), {at(-15, -8, 0), at(-15, -8, 0)});
   EXPECT_TRUE(mission.anchored(0)) << "the first scan defines the map frame";
   // A scan whose match was refused stays at its reported pose, 2 m off: in the map, but not
   // something later scans are placed against.
   const Pose off = at(-3, -7, 0);
-  mission.add(scan_at(at(-5, -9, 0), 2), off, false);
+  mission.add(scan_at(at(-5, -9, 0), 2), {off, off});
   EXPECT_FALSE(mission.anchored(1));
   const std::size_t all = mission.points_near(-4, -8, 3).size();
   const std::size_t anchored = mission.points_near(-4, -8, 3, /*anchored_only=*/true).size();
@@ -103,7 +103,7 @@ TEST_F(MissionPipelineTest, WithMatchingOffScansStayWhereTheRobotSays) {
   MissionConfig c = config();
   c.matching.reset();
   MissionPipeline mission(c);
-  mission.add(scan_at(at(-15, -8, 0), 1), at(-15, -8, 0), false);
+  mission.add(scan_at(at(-15, -8, 0), 1), {at(-15, -8, 0), at(-15, -8, 0)});
   EXPECT_FALSE(mission.place(scan_at(at(-5, -9, 0), 2), at(-5, -9, 0)));
 }
 
@@ -111,7 +111,7 @@ TEST_F(MissionPipelineTest, PlansTheNextScanInsideTheMovableRegion) {
   MissionPipeline mission(config());
   EXPECT_TRUE(mission.plan_from({-15, -8, 0}, 1).ranked.empty()) << "no map, no plan";
   mission.set_target(world_->target_region());
-  mission.add(scan_at(at(-15, -8, 0), 1), at(-15, -8, 0), false);
+  mission.add(scan_at(at(-15, -8, 0), 1), {at(-15, -8, 0), at(-15, -8, 0)});
   const Plan plan = mission.plan_from({-15, -8, 0}, 1);
   ASSERT_FALSE(plan.ranked.empty());
   const MappingPipeline& m = mission.mapping();
@@ -129,7 +129,7 @@ TEST_F(MissionPipelineTest, PlansTheNextScanInsideTheMovableRegion) {
 
 TEST_F(MissionPipelineTest, PointsNearKeepsTheMapWithinTheRadius) {
   MissionPipeline mission(config());
-  mission.add(scan_at(at(-15, -8, 0), 1), at(-15, -8, 0), false);
+  mission.add(scan_at(at(-15, -8, 0), 1), {at(-15, -8, 0), at(-15, -8, 0)});
   const PointCloud near = mission.points_near(-15, -8, 5);
   ASSERT_FALSE(near.empty());
   EXPECT_LT(near.size(), mission.placed_scans()[0]->size());
@@ -140,7 +140,7 @@ TEST_F(MissionPipelineTest, PointsNearKeepsTheMapWithinTheRadius) {
 
 TEST_F(MissionPipelineTest, NewPlannerThresholdsReachTheSegmentation) {
   MissionPipeline mission(config());
-  mission.add(scan_at(at(-15, -8, 0), 1), at(-15, -8, 0), false);
+  mission.add(scan_at(at(-15, -8, 0), 1), {at(-15, -8, 0), at(-15, -8, 0)});
   const double completed = mission.mapping().regions()->completed_m2();
   PlannerConfig planner = mission.planner();
   planner.regions.completed_radius_m = 5;

@@ -58,6 +58,38 @@ TEST_F(SessionDir, ScansSurviveReopeningWithPosesAndPoints) {
   EXPECT_EQ(s.add_scan("robot1", est, placed, 44, cloud_of(1, 0)).id, 3);
 }
 
+TEST_F(SessionDir, MatchOutcomesAndPlacementsSurviveReopening) {
+  Pose est, corrected, prior;
+  est.x = 1;
+  corrected.x = 1.4;
+  prior.x = 1.1;
+  {
+    SessionStore s(dir_);
+    s.add_scan("robot1", est, est, 1, cloud_of(10, 0));
+    s.add_scan("robot1", est, est, 2, cloud_of(10, 0));
+    s.add_scan("robot1", est, est, 3, cloud_of(10, 0));
+    EXPECT_FALSE(s.scan(1)->match) << "not matched yet";
+    s.record_match(2, {true, true, "search-gicp", "", 52.5, 0.31}, corrected);
+    s.record_match(3, {false, false, "search-gicp", "only 1% of the source points ...", 40, 0.01},
+                   prior);
+  }
+  SessionStore s(dir_);
+  const auto scans = s.scans();
+  ASSERT_EQ(scans.size(), 3u);
+  EXPECT_FALSE(scans[0].match);
+  ASSERT_TRUE(scans[1].match);
+  EXPECT_TRUE(scans[1].match->applied);
+  EXPECT_EQ(scans[1].match->method, "search-gicp");
+  EXPECT_DOUBLE_EQ(scans[1].match->time_ms, 52.5);
+  EXPECT_DOUBLE_EQ(scans[1].placed.x, 1.4);
+  ASSERT_TRUE(scans[2].match);
+  EXPECT_FALSE(scans[2].match->applied);
+  EXPECT_EQ(scans[2].match->reason, "only 1% of the source points ...");
+  EXPECT_DOUBLE_EQ(scans[2].placed.x, 1.1) << "a refused match leaves the prior";
+  EXPECT_DOUBLE_EQ(scans[2].estimated.x, 1.0);
+  EXPECT_EQ(s.scan(2)->match->inlier_ratio, 0.31);
+}
+
 TEST_F(SessionDir, EventsReadBackNewestLimitOldestFirst) {
   {
     SessionStore s(dir_);

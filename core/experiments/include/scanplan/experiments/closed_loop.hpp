@@ -33,6 +33,7 @@ struct LoopStep {
   // How far the match's result was from the truth (relative to the first scan), applied or
   // not: a refused match that was right, or an applied one that was wrong, shows here.
   std::optional<double> match_error_m, match_error_deg;
+  std::optional<Pose> match_proposed;  // where the match's result would put the scan
   // How far placed_pose is from the truth, relative to the first scan (which defines the map
   // frame): what a rescue crew reading the map would be misled by.
   double placed_error_m = 0;

@@ -9,6 +9,7 @@
 #include "scanplan/geometry/point_cloud.hpp"
 #include "scanplan/geometry/pose.hpp"
 #include "scanplan/mapping/mapping_pipeline.hpp"
+#include "scanplan/mission/sensor_frame.hpp"
 #include "scanplan/planning/fleet_planner.hpp"
 #include "scanplan/planning/scan_planner.hpp"
 #include "scanplan/registration/map_matcher.hpp"
@@ -23,6 +24,15 @@ struct MissionConfig {
   // Scan matching of each new scan against the map so far (paper §4); nothing: scans go where
   // the robot says they are.
   std::optional<MapMatchConfig> matching = MapMatchConfig{};
+  // How wrong a reported pose is, for carrying it into the map frame (SensorFrame).
+  PoseSensorNoise pose_noise;
+};
+
+// Where a scan joins the map, and how it got there.
+struct Placement {
+  Pose reported;         // what the robot's pose sensors said (their frame)
+  Pose placed;           // where the scan goes in the map frame
+  bool matched = false;  // placed by a match the sanity check believed
 };
 
 // The paper's loop as one object (§3 steps 1–4 with §4's matching), used alike by the server
@@ -34,26 +44,32 @@ class MissionPipeline {
  public:
   explicit MissionPipeline(MissionConfig config = {});
 
-  // Placed: where scan `scan` (its own frame) goes, matched against the points near `reported`
+  // Placed: where scan `scan` (its own frame) goes, matched from its reported pose carried into
+  // the map frame (prior(); a refused match leaves it there) against the points near it
   // (MapMatchConfig::target_radius_m) of the anchored scans: the first, which defines the map
-  // frame, and those placed by a match the sanity check believed. A scan left at its reported
-  // pose is metres off as often as not; matched against, it would pull every later scan near
-  // it off with it. Nothing when matching is off or nothing is anchored yet. Changes nothing.
+  // frame, and those placed by a match the sanity check believed. A scan left unmatched is
+  // metres off as often as not; matched against, it would pull every later scan near it off
+  // with it. Nothing when matching is off or nothing is anchored yet. Changes nothing.
   std::optional<MapMatch> place(const PointCloud& scan, const Pose& reported) const;
   // place() in two steps, for an owner that matches without holding its lock: what the match
   // needs from the map (nothing when there is nothing to match against), then match_to_map.
   struct MatchInput {
     PointCloud map_points;
     MapMatchConfig config;
+    Pose prior;  // the reported pose in the map frame: where the match starts
   };
   std::optional<MatchInput> match_input(const Pose& reported) const;
+  // `reported` carried into the map frame by what the anchored scans say of the pose sensors'
+  // frame (SensorFrame): where an unmatched scan is best placed.
+  Pose prior(const Pose& reported) const { return sensor_frame_.to_map(reported); }
 
-  // Mapped and segmented: the scan joins the map at `placed`; `matched` when a believed match
-  // placed it (see place(); the first scan is anchored regardless). Returns its points in the
-  // map frame (coloured; grey where the scan had no colour), shared, never copied again.
-  std::shared_ptr<const PointCloud> add(const PointCloud& scan, const Pose& placed, bool matched);
+  // Mapped and segmented: the scan joins the map at `where.placed`; it is anchored when a
+  // believed match placed it (see place(); the first scan is anchored regardless). Returns its
+  // points in the map frame (coloured; grey where the scan had no colour), shared, never
+  // copied again.
+  std::shared_ptr<const PointCloud> add(const PointCloud& scan, const Placement& where);
   // The same with the points in the map frame already made (to_map_frame).
-  void add(const PointCloud& scan, const Pose& placed, bool matched,
+  void add(const PointCloud& scan, const Placement& where,
            std::shared_ptr<const PointCloud> in_map);
   static std::shared_ptr<const PointCloud> to_map_frame(const PointCloud& scan, const Pose& placed);
 
@@ -86,6 +102,7 @@ class MissionPipeline {
   MappingPipeline mapping_;
   std::vector<std::shared_ptr<const PointCloud>> placed_;
   std::vector<std::uint8_t> anchored_;  // per entry of placed_
+  SensorFrame sensor_frame_;
 };
 
 }  // namespace scanplan

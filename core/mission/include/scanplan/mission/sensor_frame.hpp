@@ -1,0 +1,46 @@
+#pragma once
+
+#include <vector>
+
+#include "scanplan/geometry/pose.hpp"
+
+namespace scanplan {
+
+// How wrong the robot's pose sensors are, one scan at a time (DESIGN.md: σ 1 m, 5°).
+struct PoseSensorNoise {
+  double xy_sigma_m = 1.0;
+  double yaw_sigma_deg = 5.0;
+};
+
+// Where the robot's pose-sensor frame lies in the map frame (ROS's map → odom). The first scan
+// defines the map frame at the pose it was reported at, errors included: 5° of yaw error there
+// puts a scan reported correctly 100 m away 8.7 m off in the map, beyond any matcher's reach,
+// and an unmatched scan placed at its reported pose lands just as far off. Every scan a believed
+// match placed measures the offset once more (reported in the sensor frame, placed in the map
+// frame), so the estimate tightens as the mission goes on and a new scan's reported pose,
+// carried into the map frame, is wrong by little more than one scan's sensor error.
+//
+// The estimate: the x-y-yaw transform (and z shift) minimising
+//   Σ_i |placed_i − R(θ)·reported_i − t|² / σ_xy² + Σ_i (placed_yaw_i − reported_yaw_i − θ)² /
+//   σ_yaw²
+// over the anchored scans: positions far apart fix θ better than the yaw readings do.
+class SensorFrame {
+ public:
+  explicit SensorFrame(PoseSensorNoise noise = {}) : noise_(noise) {}
+
+  // One scan whose map pose is known: the first, or one placed by a believed match.
+  void add(const Pose& reported, const Pose& placed);
+  // `reported` carried into the map frame (roll and pitch as they are: the inclination sensor
+  // measures them against gravity, which both frames share). `reported` itself before any add.
+  Pose to_map(const Pose& reported) const;
+  std::size_t anchors() const { return reported_.size(); }
+
+ private:
+  void refit();
+
+  PoseSensorNoise noise_;
+  std::vector<Pose> reported_, placed_;
+  double yaw_ = 0, tx_ = 0, ty_ = 0, tz_ = 0;  // map_from_sensor
+};
+
+}  // namespace scanplan
