@@ -1,6 +1,7 @@
 #include "app/scan_intake.hpp"
 
 #include "app/domain_json.hpp"
+#include "scanplan/geometry/scan_returns.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -52,6 +53,17 @@ void ScanIntake::stop() {
 
 StoredScan ScanIntake::submit(const std::string& robot, const Pose& estimated,
                               std::int64_t stamp_ns, PointCloud cloud) {
+  const DroppedReturns dropped = drop_bad_returns(cloud);
+  if (cloud.empty()) {
+    throw UnusableScanError(
+        "no point of the scan is usable: " + std::to_string(dropped.non_finite) + " not finite, " +
+        std::to_string(dropped.mount) + " on the scanner's mount, " +
+        std::to_string(dropped.saturated) + " in a saturation shell");
+  }
+  if (dropped.total() > 0) {
+    spdlog::info("scan from '{}': dropped {} not finite, {} on the mount, {} saturated", robot,
+                 dropped.non_finite, dropped.mount, dropped.saturated);
+  }
   // Matching will correct `placed`; until then the reported pose is the best there is.
   StoredScan stored = session_.add_scan(robot, estimated, estimated, stamp_ns, cloud);
   {
@@ -59,8 +71,13 @@ StoredScan ScanIntake::submit(const std::string& robot, const Pose& estimated,
     queue_.emplace_back(stored, std::move(cloud));
   }
   wake_.notify_one();
-  events_.publish("scan_received",
-                  {{"scan", stored.id}, {"robot", robot}, {"points", stored.points}});
+  events_.publish("scan_received", {{"scan", stored.id},
+                                    {"robot", robot},
+                                    {"points", stored.points},
+                                    {"dropped",
+                                     {{"non_finite", dropped.non_finite},
+                                      {"mount", dropped.mount},
+                                      {"saturated", dropped.saturated}}}});
   return stored;
 }
 

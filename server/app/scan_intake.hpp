@@ -3,6 +3,7 @@
 #include <condition_variable>
 #include <deque>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <utility>
@@ -12,6 +13,13 @@
 #include "storage/session_store.hpp"
 
 namespace scanplan::server {
+
+// A scan in which nothing is left once the returns that are not the scene are dropped
+// (drop_bad_returns): nothing to store.
+class UnusableScanError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 // Where scans enter the session, from DDS or from POST /api/v1/scans. Each is first stored
 // durably (that is what acknowledges it), then processed into the live map on a worker thread,
@@ -28,7 +36,10 @@ class ScanIntake {
   void start();
   void stop();
 
-  // Thread-safe. Returns once the scan is on disk; throws SessionStoreError when it cannot be.
+  // Thread-safe. Drops the returns that are not the scene first (NaNs, the scanner's mount, a
+  // saturation shell: drop_bad_returns; counted in the scan_received event). Returns once the
+  // scan is on disk; throws SessionStoreError when it cannot be, UnusableScanError when no
+  // point is left.
   StoredScan submit(const std::string& robot, const Pose& estimated, std::int64_t stamp_ns,
                     PointCloud cloud);
   // Scans stored but not yet in the live map.

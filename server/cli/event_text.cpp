@@ -37,6 +37,20 @@ std::string scan_progress(const json& e) {
   return with_message(text + progress_bar(num(e, "fraction")) + " " + state, e);
 }
 
+std::string scan_received(const json& e) {
+  std::string text = "scan " + str(e, "scan") + " from " + str(e, "robot") +
+                     " stored: " + str(e, "points") + " points";
+  const auto d = e.find("dropped");
+  if (d == e.end() || !d->is_object()) return text;
+  const double non_finite = num(*d, "non_finite"), mount = num(*d, "mount"),
+               saturated = num(*d, "saturated");
+  if (non_finite + mount + saturated > 0) {
+    text += " (dropped " + fixed(non_finite, 0) + " not finite, " + fixed(mount, 0) +
+            " on the mount, " + fixed(saturated, 0) + " saturated)";
+  }
+  return text;
+}
+
 std::string match_done(const json& e) {
   std::string text = "scan " + str(e, "scan") + ": " + str(e, "method") + " " +
                      (e.value("converged", false) ? "converged" : "did not converge") + ", score " +
@@ -110,10 +124,7 @@ std::string describe_event(const json& e) {
     }
     return with_message(text, e);
   }
-  if (type == "scan_received") {
-    return "scan " + str(e, "scan") + " from " + str(e, "robot") + " stored: " + str(e, "points") +
-           " points";
-  }
+  if (type == "scan_received") return scan_received(e);
   if (type == "match_done") return match_done(e);
   if (type == "map_updated") {
     return "scan " + str(e, "scan") + " is in the map: completed " +

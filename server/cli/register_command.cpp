@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "scanplan/geometry/pose.hpp"
+#include "scanplan/geometry/scan_returns.hpp"
 #include "scanplan/io/scan_file.hpp"
 #include "scanplan/registration/registration.hpp"
 #include "scanplan/registration_pcl/pcl_registration.hpp"
@@ -27,8 +28,14 @@ struct RegisterArgs {
   double max_range = 0;  // and farther than this (saturated beams); 0: no limit
 };
 
-PointCloud read_scan(const std::string& file, const char* role, const RegisterArgs& a) {
+struct ReadScan {
+  PointCloud cloud;
+  DroppedReturns dropped;  // NaNs, the mount, a saturation shell (drop_bad_returns)
+};
+
+ReadScan read_scan(const std::string& file, const char* role, const RegisterArgs& a) {
   PointCloud cloud = read_point_cloud(file);  // ScanFileError names the file and what is wrong
+  const DroppedReturns dropped = drop_bad_returns(cloud);
   if (a.min_range > 0 || a.max_range > 0) {
     PointCloud kept;
     for (const auto& p : cloud.points) {
@@ -43,7 +50,11 @@ PointCloud read_scan(const std::string& file, const char* role, const RegisterAr
         (a.min_range > 0 || a.max_range > 0 ? " within --min-range/--max-range" : std::string()) +
         ": nothing to match");
   }
-  return cloud;
+  return {std::move(cloud), dropped};
+}
+
+nlohmann::ordered_json dropped_json(const DroppedReturns& d) {
+  return {{"non_finite", d.non_finite}, {"mount", d.mount}, {"saturated", d.saturated}};
 }
 
 void run_register(const RegisterArgs& a) {
@@ -53,8 +64,8 @@ void run_register(const RegisterArgs& a) {
         "--method " + a.method +
         ": expected ndt-icp, ndt, icp, gicp, search-gicp, pcl-ndt, pcl-icp or pcl-gicp");
   }
-  const PointCloud target = read_scan(a.target, "target", a);
-  const PointCloud source = read_scan(a.source, "source", a);
+  const ReadScan target = read_scan(a.target, "target", a);
+  const ReadScan source = read_scan(a.source, "source", a);
   Pose init;
   if (!a.init.empty()) {
     init.x = a.init[0];
@@ -64,7 +75,8 @@ void run_register(const RegisterArgs& a) {
   }
   RegistrationConfig config;
   config.dof = a.dof == 6 ? Dof::k6 : Dof::k4;
-  const RegistrationResult r = register_any(target, source, init.isometry(), *method, config);
+  const RegistrationResult r =
+      register_any(target.cloud, source.cloud, init.isometry(), *method, config);
 
   const Pose p = Pose::from_isometry(r.transform);
   // ordered_json keeps the keys in DESIGN.md's order, which reads better than sorted.
@@ -74,19 +86,22 @@ void run_register(const RegisterArgs& a) {
     for (int col = 0; col < 4; ++col) values.push_back(r.transform.matrix()(row, col));
     transform.push_back(values);
   }
-  const nlohmann::ordered_json out = {{"method", r.method},
-                                      {"transform", transform},
-                                      {"x", p.x},
-                                      {"y", p.y},
-                                      {"z", p.z},
-                                      {"roll_deg", rad2deg(p.roll)},
-                                      {"pitch_deg", rad2deg(p.pitch)},
-                                      {"yaw_deg", rad2deg(p.yaw)},
-                                      {"score", r.score},
-                                      {"rmse", r.rmse},
-                                      {"iterations", r.iterations},
-                                      {"time_ms", r.time_ms},
-                                      {"converged", r.converged}};
+  const nlohmann::ordered_json out = {
+      {"method", r.method},
+      {"transform", transform},
+      {"x", p.x},
+      {"y", p.y},
+      {"z", p.z},
+      {"roll_deg", rad2deg(p.roll)},
+      {"pitch_deg", rad2deg(p.pitch)},
+      {"yaw_deg", rad2deg(p.yaw)},
+      {"score", r.score},
+      {"rmse", r.rmse},
+      {"iterations", r.iterations},
+      {"time_ms", r.time_ms},
+      {"converged", r.converged},
+      {"dropped",
+       {{"target", dropped_json(target.dropped)}, {"source", dropped_json(source.dropped)}}}};
   // Not converged is an answer, not an error: the JSON says so and stderr says why.
   if (!r.message.empty()) std::cerr << "scanplan register: " << r.message << "\n";
   std::cout << out.dump() << std::endl;
@@ -112,9 +127,8 @@ void add_register_command(CLI::App& app) {
       ->check(CLI::IsMember({4, 6}))
       ->capture_default_str();
   cmd->add_option("--min-range", args->min_range,
-                  "drop points nearer the scanner than this, in metres: its own mount, which "
-                  "moves with it and pulls every match towards no motion (0.3 for the 3DTK "
-                  "samples)")
+                  "drop points nearer the scanner than this, in metres (points within 0.3 m, "
+                  "the scanner's own mount, NaNs and a saturation shell are always dropped)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--max-range", args->max_range,
                   "drop points farther than this, in metres (0: no limit)")

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/domain_json.hpp"
+#include "app/scan_intake.hpp"
 #include "http/http_error.hpp"
 #include "rest/request_parsing.hpp"
 #include "scanplan/io/scan_file.hpp"
@@ -95,6 +96,8 @@ Response Api::post_scan(const Request& request) {
   try {
     const StoredScan s = app_.intake.submit(robot, estimated, stamp, std::move(cloud));
     return Response::json(201, scan_json(s, std::nullopt));
+  } catch (const UnusableScanError& e) {
+    throw HttpError(400, "bad_scan", e.what());
   } catch (const SessionStoreError& e) {
     throw HttpError(503, "storage_failed",
                     std::string("the scan could not be stored: ") + e.what());

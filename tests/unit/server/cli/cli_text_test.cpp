@@ -186,6 +186,10 @@ TEST(EventText, DescribesEachEventType) {
             "scan 2 is in the map: completed 1 m2, low-res 2 m2, unscanned 3 m2, movable 4 m2");
   EXPECT_EQ(d(R"({"type":"plan_done","plan":3,"based_on_scan":2,"candidates":5,"plan_ms":12})"),
             "plan 3 after scan 2: 5 candidates in 12 ms");
+  EXPECT_EQ(d(R"({"type":"scan_received","scan":3,"robot":"robot1","points":78000,
+                  "dropped":{"non_finite":0,"mount":1973,"saturated":1481}})"),
+            "scan 3 from robot1 stored: 78000 points (dropped 0 not finite, 1973 on the mount, "
+            "1481 saturated)");
   EXPECT_EQ(d(R"({"type":"scan_received","scan":2,"robot":"robot1","points":150000})"),
             "scan 2 from robot1 stored: 150000 points");
   EXPECT_EQ(d(R"({"type":"mission","kind":"approve","candidate":12,"robot":"robot1",
