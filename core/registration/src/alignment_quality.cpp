@@ -16,20 +16,8 @@ constexpr int kNormalNeighbours = 8;
 // form a surface (too few, or spread along a line rather than a plane).
 bool surface_normal(const detail::PointKdTree& tree, const Eigen::Vector3f& q, float max_sq,
                     Eigen::Vector3d& normal) {
-  std::uint32_t index[kNormalNeighbours];
-  float sq[kNormalNeighbours];
-  const int found = tree.nearest<kNormalNeighbours>(q, max_sq, index, sq);
-  if (found < 5) return false;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (int k = 0; k < found; ++k) mean += tree.point(index[k]).cast<double>();
-  mean /= found;
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (int k = 0; k < found; ++k) {
-    const Eigen::Vector3d d = tree.point(index[k]).cast<double>() - mean;
-    cov += d * d.transpose();
-  }
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-  eig.computeDirect(cov);
+  if (!tree.local_shape<kNormalNeighbours>(q, max_sq, eig)) return false;
   // A plane has one small and two large eigenvalues; a line (a pole, an edge) has two small.
   if (eig.eigenvalues()[1] <= 0 || eig.eigenvalues()[0] > 0.1 * eig.eigenvalues()[1]) return false;
   normal = eig.eigenvectors().col(0);

@@ -52,20 +52,8 @@ class CovariedCloud {
 
  private:
   Eigen::Matrix3d plane_covariance(const Eigen::Vector3f& q) const {
-    std::uint32_t index[kNeighbours];
-    float sq[kNeighbours];
-    const int n = tree_.nearest<kNeighbours>(q, radius_sq_, index, sq);
-    if (n < 5) return Eigen::Matrix3d::Identity();
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int j = 0; j < n; ++j) mean += tree_.point(index[j]).cast<double>();
-    mean /= n;
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (int j = 0; j < n; ++j) {
-      const Eigen::Vector3d d = tree_.point(index[j]).cast<double>() - mean;
-      cov += d * d.transpose();
-    }
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-    eig.computeDirect(cov);
+    if (!tree_.local_shape<kNeighbours>(q, radius_sq_, eig)) return Eigen::Matrix3d::Identity();
     const Eigen::Vector3d values(epsilon_, 1.0, 1.0);
     return eig.eigenvectors() * values.asDiagonal() * eig.eigenvectors().transpose();
   }

@@ -4,6 +4,7 @@
 // and the Eq. 2 score. Private to the library so that nanoflann stays out of public headers.
 
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -33,6 +34,31 @@ class PointKdTree {
     sq[K - 1] = max_sq;  // the search only keeps points nearer than the current worst
     index_.findNeighbors(result, q.data(), nanoflann::SearchParams());
     return static_cast<int>(result.size());
+  }
+
+  // The shape of the surface around q: the eigen-decomposition (eigenvalues ascending) of the
+  // scatter of its up to K nearest points within sqrt(max_sq); false with fewer than 5 of them.
+  template <int K>
+  bool local_shape(const Eigen::Vector3f& q, float max_sq,
+                   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& eig) const {
+    std::uint32_t index[K];
+    float sq[K];
+    const int found = nearest<K>(q, max_sq, index, sq);
+    if (found < 5) return false;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int k = 0; k < found; ++k) {
+      const Eigen::Vector3f& p = point(index[k]);
+      mean += p.cast<double>();
+    }
+    mean /= found;
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    for (int k = 0; k < found; ++k) {
+      const Eigen::Vector3f& p = point(index[k]);
+      const Eigen::Vector3d d = p.cast<double>() - mean;
+      scatter += d * d.transpose();
+    }
+    eig.computeDirect(scatter);
+    return true;
   }
 
  private:
