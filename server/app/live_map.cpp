@@ -15,6 +15,7 @@ namespace scanplan::server {
 
 LiveMap::LiveMap(PlanBook& plans, MissionConfig config)
     : mission_(std::move(config)),
+      sensor_height_m_(mission_.config().mapping.sensor_height_m),
       plans_(plans),
       claim_separation_m_(mission_.planner().claim_separation_m),
       encoder_([this] { encode_loop(); }) {}

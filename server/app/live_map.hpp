@@ -66,6 +66,9 @@ struct MissionParams {
 class LiveMap {
  public:
   explicit LiveMap(PlanBook& plans, MissionConfig config = {});
+
+  // Where the laser sits above a scan's origin (PipelineConfig::sensor_height_m).
+  double sensor_height_m() const { return sensor_height_m_; }
   ~LiveMap();
   LiveMap(const LiveMap&) = delete;
   LiveMap& operator=(const LiveMap&) = delete;
@@ -152,7 +155,8 @@ class LiveMap {
   MapAreas areas_;
   std::map<std::int64_t, MapAreas> areas_after_;  // by scan id
   std::optional<LayerGeometry> layer_geometry_;
-  MissionPipeline mission_;                         // written only under encode_mutex_
+  MissionPipeline mission_;  // written only under encode_mutex_
+  const double sensor_height_m_;
   std::pair<std::int64_t, std::string> last_scan_;  // id and robot; under encode_mutex_
   std::map<std::string, Pose> scan_pose_of_;  // each robot's last scan pose; under encode_mutex_
   PlanBook& plans_;

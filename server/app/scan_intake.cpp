@@ -53,7 +53,12 @@ void ScanIntake::stop() {
 
 StoredScan ScanIntake::submit(const std::string& robot, const Pose& estimated,
                               std::int64_t stamp_ns, PointCloud cloud) {
-  const DroppedReturns dropped = drop_bad_returns(cloud);
+  // The laser sits sensor_height_m above the origin of the robot frame our scans use; data
+  // recorded about the laser itself (a 3DTK replay) shows it by a saturation shell there.
+  ReturnFilterConfig returns;
+  const Eigen::Vector3f robot_frame(0, 0, static_cast<float>(live_.sensor_height_m()));
+  returns.sensor = locate_sensor(cloud, {robot_frame, Eigen::Vector3f::Zero()}, returns);
+  const DroppedReturns dropped = drop_bad_returns(cloud, returns);
   if (cloud.empty()) {
     throw UnusableScanError(
         "no point of the scan is usable: " + std::to_string(dropped.non_finite) + " not finite, " +

@@ -44,9 +44,10 @@ test('bad uploads are refused with the right status and nothing is stored', asyn
   const garbage = await stack.api('POST', '/api/v1/scans?x=0&y=0&z=0&yaw_deg=0', { body: 'ply\nformat ascii 1.0\nelement vertex 99999999\n' });
   assert.equal(garbage.status, 400);
   assert.equal((await garbage.json()).error.code, 'bad_scan');
-  // Nothing but the scanner's own mount (within 0.3 m): no point is the scene.
+  // Nothing but the scanner's own mount (within 0.3 m of the laser, 1 m above the scan's
+  // origin): no point is the scene.
   const mountOnly = 'ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n' +
-    'property float z\nend_header\n0.1 0 0\n0 0.2 0\n';
+    'property float z\nend_header\n0.1 0 1\n0 0.2 0.9\n';
   const mount = await stack.api('POST', '/api/v1/scans?x=0&y=0&z=0&yaw_deg=0', { body: mountOnly });
   assert.equal(mount.status, 400);
   const mountError = (await mount.json()).error;

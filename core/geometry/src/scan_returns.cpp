@@ -5,26 +5,55 @@
 
 namespace scanplan {
 
-DroppedReturns drop_bad_returns(PointCloud& cloud, const ReturnFilterConfig& config) {
-  DroppedReturns dropped;
-  const bool colored = cloud.has_colors();
-  std::vector<float> range(cloud.size(), 0);
+namespace {
+
+struct Ranges {
+  std::vector<float> range;  // from the sensor; 0 for non-finite points
   float farthest = 0;
+  bool shell = false;  // a saturation shell at `farthest`
+};
+
+Ranges ranges_from(const PointCloud& cloud, const Eigen::Vector3f& sensor,
+                   const ReturnFilterConfig& config) {
+  Ranges r;
+  r.range.assign(cloud.size(), 0);
   std::size_t finite = 0;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     if (!cloud.points[i].allFinite()) continue;
-    range[i] = cloud.points[i].norm();
-    farthest = std::max(farthest, range[i]);
+    r.range[i] = (cloud.points[i] - sensor).norm();
+    r.farthest = std::max(r.farthest, r.range[i]);
     ++finite;
   }
   const auto band = static_cast<float>(config.saturation_band_m);
   std::size_t at_farthest = 0;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    at_farthest += cloud.points[i].allFinite() && range[i] >= farthest - band;
+    at_farthest += cloud.points[i].allFinite() && r.range[i] >= r.farthest - band;
   }
-  const bool shell =
+  r.shell =
       at_farthest >= config.min_saturated_points &&
       static_cast<double>(at_farthest) >= config.min_saturated_share * static_cast<double>(finite);
+  return r;
+}
+
+}  // namespace
+
+Eigen::Vector3f locate_sensor(const PointCloud& cloud,
+                              const std::vector<Eigen::Vector3f>& candidates,
+                              const ReturnFilterConfig& config) {
+  for (const auto& c : candidates) {
+    if (ranges_from(cloud, c, config).shell) return c;
+  }
+  return candidates.empty() ? Eigen::Vector3f::Zero() : candidates.front();
+}
+
+DroppedReturns drop_bad_returns(PointCloud& cloud, const ReturnFilterConfig& config) {
+  DroppedReturns dropped;
+  const bool colored = cloud.has_colors();
+  const Ranges r = ranges_from(cloud, config.sensor, config);
+  const std::vector<float>& range = r.range;
+  const float farthest = r.farthest;
+  const bool shell = r.shell;
+  const auto band = static_cast<float>(config.saturation_band_m);
 
   const auto mount = static_cast<float>(config.mount_radius_m);
   std::size_t out = 0;

@@ -2,6 +2,7 @@
 // NaN, the scanner's own mount, and the shell of beams that saturated at the sensor's range.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -60,6 +61,32 @@ TEST(ScanReturns, ARealSceneKeepsItsFarthestPoints) {
   PointCloud thin = scene(20000, 3);
   add_shell(thin, 60, 32.76f);
   EXPECT_EQ(drop_bad_returns(thin).saturated, 0u);
+}
+
+TEST(ScanReturns, TheShellTellsWhereTheLaserSits) {
+  // Recorded about the laser (the origin), not 1 m above it as the robot frame would have it.
+  PointCloud c = scene(20000, 4);
+  add_shell(c, 400, 32.76f);
+  const Eigen::Vector3f robot_frame(0, 0, 1), origin(0, 0, 0);
+  EXPECT_EQ(locate_sensor(c, {robot_frame, origin}), origin);
+  EXPECT_EQ(locate_sensor(scene(20000, 5), {robot_frame, origin}), robot_frame)
+      << "no shell anywhere: the first candidate";
+  // Measured from 1 m above the origin the shell is no sphere, and the mount ball lies
+  // elsewhere: the nadir ground under a robot-frame scan stays.
+  ReturnFilterConfig raised;
+  raised.sensor = robot_frame;
+  PointCloud ground = scene(20000, 6);
+  for (int i = 0; i < 100; ++i) {
+    ground.push_back({0.01f * static_cast<float>(i % 10), 0, 0}, {1, 2, 3});
+  }
+  const auto nadir = [](const PointCloud& cloud) {
+    return std::count_if(cloud.points.begin(), cloud.points.end(),
+                         [](const Eigen::Vector3f& p) { return p.norm() < 0.2f; });
+  };
+  drop_bad_returns(ground, raised);
+  EXPECT_EQ(nadir(ground), 100);
+  drop_bad_returns(ground);
+  EXPECT_EQ(nadir(ground), 0);
 }
 
 TEST(ScanReturns, AnEmptyOrUncolouredCloudIsFine) {

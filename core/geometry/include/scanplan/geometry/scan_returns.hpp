@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <vector>
 
 #include "scanplan/geometry/point_cloud.hpp"
 
@@ -14,9 +15,12 @@ namespace scanplan {
 //    the 3DTK SICK scans, ~1500 of 81k points), a sphere of phantom points at one range. A
 //    real scene's ranges spread out; a share of at least min_saturated_share of the points
 //    within saturation_band_m of the farthest range is taken for a shell and dropped.
-// Ranges are measured from the scan frame's origin: the sensor for 3DTK data, the robot's base
-// below it for ours (where a 0.3 m ball holds at most the ground under the robot's body).
+// Ranges are measured from `sensor`, the laser's centre in the scan frame: the origin for 3DTK
+// files, the mount height above it in the robot frame our scans and the MLS map use
+// (PipelineConfig::sensor_height_m; measured from the origin there, the ground under the robot,
+// swept densely by the fan's nadir, would be taken for the mount).
 struct ReturnFilterConfig {
+  Eigen::Vector3f sensor = Eigen::Vector3f::Zero();
   double mount_radius_m = 0.3;
   double saturation_band_m = 0.05;
   double min_saturated_share = 0.005;
@@ -32,5 +36,12 @@ struct DroppedReturns {
 
 // Drops those returns from `cloud` (colours kept in step) and says how many of each.
 DroppedReturns drop_bad_returns(PointCloud& cloud, const ReturnFilterConfig& config = {});
+
+// Of `candidates` (where the laser may sit in the scan frame), the one a saturation shell is
+// centred on, if any shows one; otherwise the first. A shell is a sphere about the laser, so
+// it tells data recorded about the laser (3DTK files) from data in the robot frame.
+Eigen::Vector3f locate_sensor(const PointCloud& cloud,
+                              const std::vector<Eigen::Vector3f>& candidates,
+                              const ReturnFilterConfig& config = {});
 
 }  // namespace scanplan
