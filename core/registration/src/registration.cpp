@@ -149,6 +149,7 @@ RegistrationConfig scale_lengths(const RegistrationConfig& config, double factor
   c.score_max_distance_m *= factor;
   for (GicpStage& stage : c.gicp.stages) {
     stage.voxel_m *= factor;
+    stage.source_voxel_m *= factor;
     stage.max_correspondence_m *= factor;
   }
   c.gicp.translation_tolerance_m *= factor;
