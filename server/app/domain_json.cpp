@@ -63,6 +63,7 @@ json candidate_json(const CandidateRecord& r, const std::string& robot, std::uin
           {"f", c.f},
           {"gain_unscanned_m2", c.gain_unscanned_m2},
           {"gain_low_res_m2", c.gain_low_res_m2},
+          {"overlap_m2", c.overlap_m2},
           {"travel_m", c.travel_m},
           {"score", c.score},
           {"path", path}};

@@ -29,9 +29,10 @@ ScanGain ScanGainEvaluator::at(CellIndex b, double floor_z,
                                VisibilityPredictor::Workspace& ws) const {
   const auto& grid = regions_.cells;
   const std::int64_t bi = b.x - grid.origin.x, bj = b.y - grid.origin.y;
-  std::size_t unscanned = 0, low_resolution = 0, unscanned_near = 0;
+  std::size_t unscanned = 0, low_resolution = 0, unscanned_near = 0, mapped = 0;
   for (const std::uint32_t o : predictor_.visible_from(b, floor_z, ws)) {
     const Region r = grid.values[o];
+    mapped += r == Region::kCompleted || r == Region::kLowResolution;
     if (r != Region::kUnscanned && r != Region::kLowResolution) continue;
     // C_B: within the completed radius of B, measured between cell centres as
     // segment_regions measures it.
@@ -49,6 +50,7 @@ ScanGain ScanGainEvaluator::at(CellIndex b, double floor_z,
   g.unscanned_m2 = static_cast<double>(unscanned) * regions_.cell_area_m2();
   g.low_resolution_m2 = static_cast<double>(low_resolution) * regions_.cell_area_m2();
   g.completed_m2 = static_cast<double>(unscanned_near + low_resolution) * regions_.cell_area_m2();
+  g.overlap_m2 = static_cast<double>(mapped) * regions_.cell_area_m2();
   g.f = alpha_ * g.unscanned_m2 + (1 - alpha_) * g.low_resolution_m2;
   return g;
 }

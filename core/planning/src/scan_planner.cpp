@@ -558,6 +558,7 @@ std::vector<Candidate> to_candidates(const std::vector<Scored>& chosen, const Si
     c.gain_unscanned_m2 = s.gain.unscanned_m2;
     c.gain_low_res_m2 = s.gain.low_resolution_m2;
     c.gain_completed_m2 = s.gain.completed_m2;
+    c.overlap_m2 = s.gain.overlap_m2;
     c.travel_m = sites.travel_m[u];
     c.path = travel.path_to(sites.cell[u]);
     c.score = s.score;
@@ -638,6 +639,7 @@ double evaluate(const PlanInput& in, const PlannerConfig& cfg, const Eigen::Vect
     detail->gain_unscanned_m2 = g.unscanned_m2;
     detail->gain_low_res_m2 = g.low_resolution_m2;
     detail->gain_completed_m2 = g.completed_m2;
+    detail->overlap_m2 = g.overlap_m2;
   }
   return g.f;
 }

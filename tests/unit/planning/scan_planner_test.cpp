@@ -108,6 +108,8 @@ TEST_F(WallYard, ExhaustiveBreaksNearTiesInFByCompletion) {
   // What is completed is at most what is seen within 20 m: U and M cells in C_B.
   EXPECT_LE(top.gain_low_res_m2, top.gain_completed_m2);
   EXPECT_LE(top.gain_completed_m2, top.gain_low_res_m2 + top.gain_unscanned_m2);
+  // Seen from B, the map so far: what matching the scan there will go on.
+  EXPECT_GT(top.overlap_m2, 100.0);
   cfg.completion_weight = -1;
   EXPECT_THROW(plan_next_scan(input(), cfg), std::invalid_argument);
 }

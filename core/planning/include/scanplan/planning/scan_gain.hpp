@@ -18,6 +18,9 @@ struct ScanGain {
   // area((U∪M_A)∩C_B): what the scan would bring into C. Not a term of F; the exhaustive
   // policy breaks near-ties in F with it (PlannerConfig::completion_weight).
   double completed_m2 = 0;
+  // area((C_A∪M_A) seen from B): what a scan from B is predicted to see of the map so far, the
+  // overlap scan matching will have to go on (issue 15). Not a term of F.
+  double overlap_m2 = 0;
 };
 
 // Evaluates Eq. 1 at cells of the map against one region segmentation. Cheap to call many

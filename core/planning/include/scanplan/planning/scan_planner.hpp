@@ -89,6 +89,7 @@ struct Candidate {
   double gain_unscanned_m2 = 0;                        // area((U∩C_B) ∪ (U∩M_B))
   double gain_low_res_m2 = 0;                          // area(M_A∩C_B)
   double gain_completed_m2 = 0;  // area((U∪M_A)∩C_B): what the scan brings into C (not in F)
+  double overlap_m2 = 0;         // area of the map so far seen from B (ScanGain::overlap_m2)
   double travel_m = 0;           // path length over the movable region from the robot
   std::vector<Eigen::Vector2d> path;  // cell centres from the robot to B
   // What the policy ranked by: F (paper, random), F + completion_weight · gain_completed_m2
