@@ -33,7 +33,6 @@ class SensorFrame {
   // `reported` carried into the map frame (roll and pitch as they are: the inclination sensor
   // measures them against gravity, which both frames share). `reported` itself before any add.
   Pose to_map(const Pose& reported) const;
-  std::size_t anchors() const { return reported_.size(); }
 
  private:
   void refit();
