@@ -50,6 +50,12 @@ json candidate_json(const CandidateRecord& r, const std::string& robot, std::uin
   const Candidate& c = r.candidate;
   json path = json::array();
   for (const auto& p : c.path) path.push_back({p.x(), p.y()});
+  json registrability = nullptr;
+  if (c.registrability) {
+    registrability = {{"overlap_share", c.registrability->overlap_share},
+                      {"pose_fixing", c.registrability->pose_fixing},
+                      {"factor", c.registrability->factor}};
+  }
   return {{"id", r.id},
           {"robot", robot},
           {"plan", plan},
@@ -64,6 +70,7 @@ json candidate_json(const CandidateRecord& r, const std::string& robot, std::uin
           {"gain_unscanned_m2", c.gain_unscanned_m2},
           {"gain_low_res_m2", c.gain_low_res_m2},
           {"overlap_m2", c.overlap_m2},
+          {"registrability", registrability},
           {"travel_m", c.travel_m},
           {"score", c.score},
           {"path", path}};

@@ -289,6 +289,7 @@ CandidateRecord LiveMap::add_goal(double x, double y, const std::string& robot_i
   CandidateRecord record;
   PlanInput input{mapping.map(), *mapping.target(), points, from};
   input.claimed = &claims;
+  input.anchored = mission_.anchored_map();
   evaluate(input, planner, {centre.x(), centre.y(), site.floor_z}, &record.candidate);
   record.candidate.travel_m = site.travel.distance(site.cell);
   record.candidate.path = site.travel.path_to(site.cell);

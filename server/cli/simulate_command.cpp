@@ -23,6 +23,7 @@ struct SimulateArgs {
   int max_scans = 13;
   std::uint64_t seed = 1;
   std::string match = "on";
+  std::string registrability = "on";
 };
 
 nlohmann::json optional_json(const auto& v) {
@@ -44,6 +45,7 @@ ClosedLoopConfig config_of(const SimulateArgs& a) {
   config.max_scans = a.max_scans;
   config.seed = a.seed;
   if (a.match == "off") config.matching.reset();
+  config.planner.registrability.enabled = a.registrability == "on";
   return config;
 }
 
@@ -71,9 +73,19 @@ nlohmann::json pose_json(const Pose& p) {
   return {{"x", p.x}, {"y", p.y}, {"z", p.z}, {"yaw_deg", rad2deg(p.yaw)}};
 }
 
+// What the plan that sent the robot to a scan forecast of its match (Candidate::registrability).
+nlohmann::json forecast_json(const LoopStep* previous) {
+  if (!previous || !previous->chosen) return nullptr;
+  const std::optional<Registrability>& r =
+      previous->candidates.at(*previous->chosen).registrability;
+  if (!r) return nullptr;
+  return {
+      {"overlap_share", r->overlap_share}, {"pose_fixing", r->pose_fixing}, {"factor", r->factor}};
+}
+
 // One scan as summary.json lists it (DESIGN.md "CLI"): where the robot said it was, where the
 // map put it and where it really was, all in the map frame (the first scan's), and the match.
-nlohmann::json scan_json(const LoopStep& s, const LoopStep& first) {
+nlohmann::json scan_json(const LoopStep& s, const LoopStep& first, const LoopStep* previous) {
   nlohmann::json match = nullptr;
   if (s.match) {
     match = {{"applied", s.match_applied},  {"converged", s.match->converged},
@@ -92,7 +104,8 @@ nlohmann::json scan_json(const LoopStep& s, const LoopStep& first) {
           {"true", pose_json(true_in_map(first.placed_pose, first.true_pose, s.true_pose))},
           {"placed_error_m", s.placed_error_m},
           {"placed_error_deg", s.placed_error_deg},
-          {"match", match}};
+          {"match", match},
+          {"forecast", forecast_json(previous)}};
 }
 
 // How the map's poses came out: matches tried and applied, and the placed error against the
@@ -136,9 +149,10 @@ nlohmann::json summary_of(const SimulateArgs& a, const World& world, const Close
   // Where each scan was really taken (x, y, z, yaw_deg): to take the same scans again, e.g.
   // with `scanplan scan` for a server benchmark.
   nlohmann::json true_poses = nlohmann::json::array(), scans = nlohmann::json::array();
-  for (const auto& s : r.steps) {
+  for (std::size_t k = 0; k < r.steps.size(); ++k) {
+    const LoopStep& s = r.steps[k];
     true_poses.push_back({s.true_pose.x, s.true_pose.y, s.true_pose.z, rad2deg(s.true_pose.yaw)});
-    scans.push_back(scan_json(s, r.steps.front()));
+    scans.push_back(scan_json(s, r.steps.front(), k > 0 ? &r.steps[k - 1] : nullptr));
   }
   const double cell_m = config.pipeline.mls.cell_m;
   return {{"world", world.name},
@@ -146,6 +160,7 @@ nlohmann::json summary_of(const SimulateArgs& a, const World& world, const Close
           {"alpha", a.alpha},
           {"seed", a.seed},
           {"match", a.match},
+          {"registrability", a.registrability},
           {"scans", scans},
           {"detected_m2", last.detected_m2},
           {"completed_m2", last.completed_m2},
@@ -211,6 +226,10 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--max-scans", args->max_scans, "scans at most")->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed for noise and the planner")->capture_default_str();
   cmd->add_option("--match", args->match, "scan matching of each scan against the map (on|off)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"on", "off"}));
+  cmd->add_option("--registrability", args->registrability,
+                  "the planner scales down candidates the matcher is forecast to fail at (on|off)")
       ->capture_default_str()
       ->check(CLI::IsMember({"on", "off"}));
   cmd->add_option("--out", args->out,

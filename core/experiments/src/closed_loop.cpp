@@ -11,17 +11,20 @@ namespace scanplan {
 namespace {
 
 // The coverage denominator: MLS cells of the target region holding ground the robot could
-// reach from its start in the true world (DESIGN.md: coverage_pct).
+// reach from its start in the true world (DESIGN.md: coverage_pct), as cells of the map, whose
+// frame (the first scan's placed pose) is `map_from_world` from the world's.
 std::vector<CellIndex> reachable_ground_cells(const World& world, const WorldTraversability& trav,
                                               const WorldTraversability::Reach& reach,
-                                              const MlsMap& map) {
+                                              const MlsMap& map,
+                                              const Eigen::Isometry3d& map_from_world) {
   std::set<std::pair<std::int32_t, std::int32_t>> cells;
   for (std::size_t c = 0; c < trav.cell_count(); ++c) {
     if (!reach.reachable(c)) continue;
     const Eigen::Vector2d p = trav.cell_center(c);
-    const CellIndex i = map.index_of(p.x(), p.y());
-    const Eigen::Vector2d center = map.center_of(i);
-    if (world.in_target_region(center.x(), center.y())) cells.insert({i.x, i.y});
+    if (!world.in_target_region(p.x(), p.y())) continue;
+    const Eigen::Vector3d in_map = map_from_world * Eigen::Vector3d(p.x(), p.y(), 0);
+    const CellIndex i = map.index_of(in_map.x(), in_map.y());
+    cells.insert({i.x, i.y});
   }
   std::vector<CellIndex> out;
   out.reserve(cells.size());
@@ -39,13 +42,16 @@ double coverage_pct(const RegionMap& regions, const std::vector<CellIndex>& grou
 
 // The operator approving the best suggestion the robot can really reach: the first ranked
 // candidate reachable in the true world (the map was built from noisy poses, so a suggestion
-// may not be drivable). Moves `truth` there and adds the drive to `path_m`.
+// may not be drivable). The candidates are places on the map, and the robot goes to that place
+// (`world_from_map`, the first scan's true pose against where it was placed), as a robot that
+// navigates on the map does. Moves `truth` there and adds the drive to `path_m`.
 std::optional<std::size_t> drive_to_best(const WorldTraversability& trav,
-                                         const std::vector<Candidate>& ranked, Pose& truth,
+                                         const std::vector<Candidate>& ranked,
+                                         const Eigen::Isometry3d& world_from_map, Pose& truth,
                                          double& path_m) {
   const auto reach = trav.reach_from(truth.x, truth.y, truth.z);
   for (std::size_t k = 0; k < ranked.size(); ++k) {
-    const Eigen::Vector3d& goal = ranked[k].position;
+    const Eigen::Vector3d goal = world_from_map * ranked[k].position;
     const auto cell = trav.cell_of(goal.x(), goal.y());
     if (cell && reach.reachable(*cell)) {
       path_m += reach.distance_m[*cell];
@@ -83,13 +89,14 @@ LoopResult run_closed_loop(
                                {world.pose_noise.xy_sigma_m, world.pose_noise.yaw_sigma_deg}};
   mission_config.mapping.sensor_height_m = world.scanner.mount_height_m;
   MissionPipeline mission(mission_config);
-  mission.set_target(world.target_region());
   const MappingPipeline& pipeline = mission.mapping();
-  const auto ground = reachable_ground_cells(
-      world, trav, trav.reach_from(truth.x, truth.y, truth.z), pipeline.map());
+  const auto start_reach = trav.reach_from(truth.x, truth.y, truth.z);
+  // The map's frame is the first scan's placed (reported) pose, not the world's: the target
+  // region and the ground to cover are carried into it once that scan is in.
+  Eigen::Isometry3d world_from_map = Eigen::Isometry3d::Identity();
+  std::vector<CellIndex> ground;
 
   LoopResult result;
-  result.reachable_cells = ground.size();
   std::mt19937_64 pose_rng(config.seed);
   double path_m = 0;
   for (int scan = 1; scan <= config.max_scans; ++scan) {
@@ -100,6 +107,18 @@ LoopResult run_closed_loop(
                                            config.seed * 7919 + static_cast<std::uint64_t>(scan));
     step.reported_pose = reported_pose(truth, world.pose_noise, pose_rng);
     step.placed_pose = step.reported_pose;
+    if (scan == 1) {
+      world_from_map = truth.isometry() * step.reported_pose.isometry().inverse();
+      const Eigen::Isometry3d map_from_world = world_from_map.inverse();
+      std::vector<Eigen::Vector2d> corners;
+      const TargetRegion target = world.target_region();
+      for (const Eigen::Vector2d& c : target.corners()) {
+        corners.push_back((map_from_world * Eigen::Vector3d(c.x(), c.y(), 0)).head<2>());
+      }
+      mission.set_target(TargetRegion::polygon(std::move(corners)));
+      ground = reachable_ground_cells(world, trav, start_reach, pipeline.map(), map_from_world);
+      result.reachable_cells = ground.size();
+    }
     if (const auto m = mission.place(cloud, step.reported_pose)) {
       step.match = m->result;
       step.match_applied = m->applied;
@@ -140,7 +159,7 @@ LoopResult run_closed_loop(
       step.plan_ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       step.candidates = plan.ranked;
-      step.chosen = drive_to_best(trav, plan.ranked, truth, path_m);
+      step.chosen = drive_to_best(trav, plan.ranked, world_from_map, truth, path_m);
     }
     if (on_step) on_step(step, pipeline);
     result.steps.push_back(std::move(step));

@@ -17,7 +17,9 @@ PipelineConfig with_planner_thresholds(PipelineConfig mapping, const PlannerConf
 MissionPipeline::MissionPipeline(MissionConfig config)
     : config_(std::move(config)),
       mapping_(with_planner_thresholds(config_.mapping, config_.planner)),
-      sensor_frame_(config_.pose_noise) {}
+      sensor_frame_(config_.pose_noise) {
+  if (config_.matching) anchored_map_.emplace(config_.mapping.mls);
+}
 
 bool MissionPipeline::has_map() const {
   return mapping_.regions() && mapping_.movable() && mapping_.target();
@@ -61,7 +63,13 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
   mapping_.add_scan(scan, where.placed);
   const bool anchored = placed_.empty() || where.matched;
   anchored_.push_back(anchored ? 1 : 0);
-  if (anchored) sensor_frame_.add(where.reported, where.placed);
+  if (anchored) {
+    sensor_frame_.add(where.reported, where.placed);
+    if (anchored_map_) {
+      anchored_map_->insert_scan(scan, where.placed.isometry(),
+                                 Eigen::Vector3d(0, 0, config_.mapping.sensor_height_m));
+    }
+  }
   placed_.push_back(std::move(in_map));
 }
 
@@ -69,7 +77,7 @@ std::vector<FleetPlan> MissionPipeline::plan(const std::vector<FleetRobot>& robo
                                              std::vector<Eigen::Vector3d> claimed) const {
   if (!has_map()) return {};
   return plan_fleet(mapping_.map(), *mapping_.target(), mapping_.scan_points(), robots,
-                    std::move(claimed), config_.planner);
+                    std::move(claimed), config_.planner, anchored_map());
 }
 
 Plan MissionPipeline::plan_from(const Eigen::Vector3d& robot, std::uint64_t seed) const {
@@ -77,7 +85,9 @@ Plan MissionPipeline::plan_from(const Eigen::Vector3d& robot, std::uint64_t seed
   PlannerConfig planner = config_.planner;
   planner.seed = seed;
   const std::vector<Eigen::Vector2d> points = mapping_.scan_points();
-  return plan_next_scan({mapping_.map(), *mapping_.target(), points, robot}, planner);
+  PlanInput in{mapping_.map(), *mapping_.target(), points, robot};
+  in.anchored = anchored_map();
+  return plan_next_scan(in, planner);
 }
 
 void MissionPipeline::set_planner(const PlannerConfig& planner) {

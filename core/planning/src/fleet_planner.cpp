@@ -9,7 +9,8 @@ namespace scanplan {
 std::vector<FleetPlan> plan_fleet(const MlsMap& map, const TargetRegion& target,
                                   const std::vector<Eigen::Vector2d>& scan_points,
                                   const std::vector<FleetRobot>& robots,
-                                  std::vector<Eigen::Vector3d> claimed, const PlannerConfig& cfg) {
+                                  std::vector<Eigen::Vector3d> claimed, const PlannerConfig& cfg,
+                                  const MlsMap* anchored) {
   if (!(cfg.fleet_tie_share >= 0 && cfg.fleet_tie_share < 1)) {
     throw std::invalid_argument("planner config: fleet_tie_share must be in [0, 1)");
   }
@@ -27,6 +28,7 @@ std::vector<FleetPlan> plan_fleet(const MlsMap& map, const TargetRegion& target,
       PlanInput in{map, target, scan_points, r.position};
       in.claimed = &claimed;
       in.occupied = &others;
+      in.anchored = anchored;
       plans.push_back(plan_next_scan(in, cfg));
     }
     // The highest best score; then, among those close to it, the shortest drive.

@@ -8,8 +8,10 @@ namespace scanplan {
 
 ScanGainEvaluator::ScanGainEvaluator(const MlsMap& map, const RegionMap& regions, double alpha,
                                      const RegionConfig& region_config,
-                                     const VisibilityConfig& visibility)
+                                     const VisibilityConfig& visibility,
+                                     const RegistrabilityField* registrability)
     : regions_(regions),
+      registrability_(registrability),
       alpha_(alpha),
       completed_radius_cells2_(std::pow(region_config.completed_radius_m / map.cell_m(), 2)),
       predictor_(map, regions.cells, visibility) {
@@ -30,14 +32,17 @@ ScanGain ScanGainEvaluator::at(CellIndex b, double floor_z,
   const auto& grid = regions_.cells;
   const std::int64_t bi = b.x - grid.origin.x, bj = b.y - grid.origin.y;
   std::size_t unscanned = 0, low_resolution = 0, unscanned_near = 0, mapped = 0;
+  std::optional<RegistrabilityField::Forecast> forecast;
+  if (registrability_) forecast.emplace(*registrability_);
   for (const std::uint32_t o : predictor_.visible_from(b, floor_z, ws)) {
     const Region r = grid.values[o];
+    const auto di = static_cast<int>(static_cast<std::int64_t>(o % grid.cols) - bi);
+    const auto dj = static_cast<int>(static_cast<std::int64_t>(o / grid.cols) - bj);
+    if (forecast) forecast->add(o, di, dj);
     mapped += r == Region::kCompleted || r == Region::kLowResolution;
     if (r != Region::kUnscanned && r != Region::kLowResolution) continue;
     // C_B: within the completed radius of B, measured between cell centres as
     // segment_regions measures it.
-    const double di = static_cast<double>(static_cast<std::int64_t>(o % grid.cols) - bi);
-    const double dj = static_cast<double>(static_cast<std::int64_t>(o / grid.cols) - bj);
     const bool near = di * di + dj * dj < completed_radius_cells2_;
     if (r == Region::kUnscanned) {
       ++unscanned;
@@ -52,6 +57,7 @@ ScanGain ScanGainEvaluator::at(CellIndex b, double floor_z,
   g.completed_m2 = static_cast<double>(unscanned_near + low_resolution) * regions_.cell_area_m2();
   g.overlap_m2 = static_cast<double>(mapped) * regions_.cell_area_m2();
   g.f = alpha_ * g.unscanned_m2 + (1 - alpha_) * g.low_resolution_m2;
+  if (forecast) g.registrability = forecast->result();
   return g;
 }
 

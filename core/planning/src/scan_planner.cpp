@@ -69,6 +69,16 @@ void check_config(const PlannerConfig& c) {
   if (!(c.robot_clearance_m >= 0)) fail("robot_clearance_m must be zero or more");
   if (!std::isfinite(c.min_gain_m2)) fail("min_gain_m2 must be finite");
   if (c.threads < 0) fail("threads must be zero (OpenMP default) or more");
+  const RegistrabilityConfig& r = c.registrability;
+  if (!(r.min_overlap_share > 0 && r.min_overlap_share <= 1))
+    fail("registrability.min_overlap_share must be in (0, 1]");
+  if (!(r.min_pose_fixing > 0 && std::isfinite(r.min_pose_fixing)))
+    fail("registrability.min_pose_fixing must be greater than zero");
+  if (!(r.floor_share >= 0 && r.floor_share <= 1))
+    fail("registrability.floor_share must be in [0, 1]");
+  if (!(r.near_range_m > 0 && std::isfinite(r.near_range_m)))
+    fail("registrability.near_range_m must be greater than zero");
+  if (!std::isfinite(r.wall_min_extent_m)) fail("registrability.wall_min_extent_m must be finite");
 }
 
 // SplitMix64: a seeded stream that is the same on every platform and standard library.
@@ -185,7 +195,7 @@ using Scorer = std::function<double(std::int32_t site, const ScanGain& gain)>;
 using ScorerFor = std::function<Scorer(double best_f)>;
 
 double by_gain(std::int32_t, const ScanGain& g) {
-  return g.f;
+  return registrable_f(g);
 }
 Scorer gain_only(double) {
   return by_gain;
@@ -489,7 +499,7 @@ std::vector<Scored> choose(const PlannerConfig& cfg, const ScanGainEvaluator& ga
     case PlannerPolicy::kExhaustive: {
       const double w = cfg.completion_weight;
       const Scorer with_completion = [w](std::int32_t, const ScanGain& g) {
-        return g.f + w * g.completed_m2;
+        return registrable_f(g) + w * g.completed_m2;
       };
       auto all = evaluate_sites(gain, sites, lattice_sites(sites, cfg.lattice_m, cell_m), threads,
                                 with_completion);
@@ -506,7 +516,7 @@ std::vector<Scored> choose(const PlannerConfig& cfg, const ScanGainEvaluator& ga
         const double free_m = cfg.travel_free_m;
         return [&sites, per_m, free_m](std::int32_t site, const ScanGain& g) {
           const double drive = sites.travel_m[static_cast<std::size_t>(site)];
-          return g.f - per_m * std::max(0.0, drive - free_m);
+          return registrable_f(g) - per_m * std::max(0.0, drive - free_m);
         };
       };
       chosen = rank(hill_climb(gain, sites, cfg, cell_m, threads, traded, evaluations), sites, cfg,
@@ -559,12 +569,26 @@ std::vector<Candidate> to_candidates(const std::vector<Scored>& chosen, const Si
     c.gain_low_res_m2 = s.gain.low_resolution_m2;
     c.gain_completed_m2 = s.gain.completed_m2;
     c.overlap_m2 = s.gain.overlap_m2;
+    c.registrability = s.gain.registrability;
     c.travel_m = sites.travel_m[u];
     c.path = travel.path_to(sites.cell[u]);
     c.score = s.score;
     out.push_back(std::move(c));
   }
   return out;
+}
+
+// The anchored map on the regions' grid, when there is one to forecast the matcher on.
+std::optional<RegistrabilityField> registrability_field(const PlanInput& in,
+                                                        const PlannerConfig& cfg,
+                                                        const RegionMap& regions) {
+  if (!in.anchored) return std::nullopt;
+  if (in.anchored->cell_m() != in.map.cell_m()) {
+    throw std::invalid_argument(
+        "plan_next_scan: the anchored map and the map must share one cell size");
+  }
+  return RegistrabilityField(*in.anchored, regions.cells.origin, regions.cells.cols,
+                             regions.cells.rows, cfg.registrability);
 }
 
 // The segmentation and the movable region flooded from the robot; returns where the robot
@@ -612,8 +636,9 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
   // scans; plan.regions stays the map's own.
   RegionMap claimed_regions;
   if (!claims.empty()) claimed_regions = plan.regions;
+  const std::optional<RegistrabilityField> field = registrability_field(in, cfg, plan.regions);
   const ScanGainEvaluator gain(in.map, claims.empty() ? plan.regions : claimed_regions, cfg.alpha,
-                               cfg.regions, cfg.visibility);
+                               cfg.regions, cfg.visibility, field ? &*field : nullptr);
   if (!claims.empty())
     claim_predicted_scans(claimed_regions, gain.predictor(), claims, cfg.regions);
   const std::vector<Scored> chosen =
@@ -628,7 +653,9 @@ double evaluate(const PlanInput& in, const PlannerConfig& cfg, const Eigen::Vect
   if (!b.allFinite()) throw std::invalid_argument("evaluate: the scan point is not finite");
   const std::vector<Eigen::Vector3d>& claims = claims_of(in);
   RegionMap regions = segment_regions(in.map, in.target, in.scan_points, cfg.regions);
-  const ScanGainEvaluator gain(in.map, regions, cfg.alpha, cfg.regions, cfg.visibility);
+  const std::optional<RegistrabilityField> field = registrability_field(in, cfg, regions);
+  const ScanGainEvaluator gain(in.map, regions, cfg.alpha, cfg.regions, cfg.visibility,
+                               field ? &*field : nullptr);
   if (!claims.empty()) claim_predicted_scans(regions, gain.predictor(), claims, cfg.regions);
   const CellIndex c = in.map.index_of(b.x(), b.y());
   const ScanGain g = gain.at(c, b.z());
@@ -640,6 +667,7 @@ double evaluate(const PlanInput& in, const PlannerConfig& cfg, const Eigen::Vect
     detail->gain_low_res_m2 = g.low_resolution_m2;
     detail->gain_completed_m2 = g.completed_m2;
     detail->overlap_m2 = g.overlap_m2;
+    detail->registrability = g.registrability;
   }
   return g.f;
 }

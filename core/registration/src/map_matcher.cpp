@@ -30,7 +30,17 @@ MapMatch match_to_map(const PointCloud& map_points, const PointCloud& scan, cons
   out.result = register_scans(target, scan, initial, config.method, sized);
   const Pose corrected = Pose::from_isometry(map_from_level * out.result.transform);
   if (out.result.iterations > 0) out.proposed = corrected;
-  if (!out.result.converged) return out;
+  const auto refuse = [&]() -> MapMatch {
+    if (!config.level_refused) return out;
+    // The level frame is vertical, so its z offset is the map's.
+    if (const auto dz = ground_offset(target, scan, initial, config.ground);
+        dz && std::abs(*dz) <= config.max_level_m) {
+      out.placed.z += *dz;
+      out.levelled = true;
+    }
+    return out;
+  };
+  if (!out.result.converged) return refuse();
 
   const double shift = std::hypot(std::hypot(corrected.x - reported.x, corrected.y - reported.y),
                                   corrected.z - reported.z);
@@ -40,7 +50,7 @@ MapMatch match_to_map(const PointCloud& map_points, const PointCloud& scan, cons
     out.result.message = "the match moved the scan " + std::to_string(shift) + " m and " +
                          std::to_string(rad2deg(turn)) +
                          "°, more than the pose sensors can be wrong: not applied";
-    return out;
+    return refuse();
   }
   out.placed = corrected;
   out.applied = true;

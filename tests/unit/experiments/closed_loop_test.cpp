@@ -51,6 +51,30 @@ TEST(ClosedLoop, CoverageGrowsAndTheRobotDrivesToTheSuggestions) {
   EXPECT_FALSE(r.steps.back().chosen) << "no plan after the last scan";
 }
 
+// The suggestions are places on the map, whose frame is the first scan's reported pose, not the
+// world's: the robot goes to the place the operator approved, wherever the map frame lies in
+// the world. (Taken as world coordinates, a goal 100 m out in a map turned 5° lands 9 m off.)
+TEST(ClosedLoop, TheRobotGoesWhereTheMapSaysNotToTheSameWorldCoordinates) {
+  World w = yard();
+  w.pose_noise = PoseNoise{1.0, 0.1, 8.0};
+  ClosedLoopConfig c = quick(3);
+  c.matching.reset();
+  c.seed = 3;
+  const LoopResult r = run_closed_loop(w, c);
+  ASSERT_EQ(r.steps.size(), 3u);
+  const Pose& first_true = r.steps[0].true_pose;
+  const Pose& first_placed = r.steps[0].placed_pose;
+  ASSERT_GT(std::abs(first_placed.yaw - first_true.yaw), deg2rad(0.5)) << "the map frame is turned";
+  for (std::size_t k = 1; k < r.steps.size(); ++k) {
+    const LoopStep& before = r.steps[k - 1];
+    ASSERT_TRUE(before.chosen);
+    const Eigen::Vector3d goal = before.candidates[*before.chosen].position;
+    const Pose in_map = true_in_map(first_placed, first_true, r.steps[k].true_pose);
+    EXPECT_LT(std::hypot(in_map.x - goal.x(), in_map.y - goal.y()), 1e-6) << "scan " << k + 1;
+  }
+  EXPECT_GT(r.reachable_cells, 500u);
+}
+
 // Each scan after the first is matched against the map so far; an applied correction puts it
 // where it was taken (relative to the first scan, which defines the map frame), a refused one
 // leaves it at the reported pose. (How many are applied in the loop is issue 15's measure.)

@@ -258,6 +258,47 @@ TEST_F(WallYard, ConfigOutOfRangeIsRefused) {
                std::invalid_argument);
 }
 
+// With an anchored map (the scans the matcher trusts) every candidate carries the forecast of
+// its match, and F is scaled down where a scan would have nothing trusted to match against.
+TEST_F(WallYard, CandidatesCarryTheMatchForecastAndTheUnregistrableLoseTheirScore) {
+  for (const PlannerPolicy p : {PlannerPolicy::kPaper, PlannerPolicy::kExhaustive}) {
+    PlannerConfig cfg;
+    cfg.policy = p;
+    PlanInput in = input();
+    in.anchored = map_;  // the one scan is the anchored map
+    const Plan trusted = plan_next_scan(in, cfg);
+    ASSERT_FALSE(trusted.ranked.empty());
+    for (const Candidate& c : trusted.ranked) {
+      ASSERT_TRUE(c.registrability) << policy_name(p);
+      EXPECT_GT(c.registrability->overlap_share, 0.3) << c.position.transpose();
+      EXPECT_GT(c.registrability->pose_fixing, 0) << c.position.transpose();
+    }
+    EXPECT_FALSE(plan_next_scan(input(), cfg).ranked.front().registrability)
+        << "no anchored map, no forecast";
+    // Nothing anchored: every candidate keeps the least share of its F.
+    const MlsMap nothing;
+    in.anchored = &nothing;
+    const Plan untrusted = plan_next_scan(in, cfg);
+    ASSERT_FALSE(untrusted.ranked.empty());
+    for (const Candidate& c : untrusted.ranked) {
+      ASSERT_TRUE(c.registrability);
+      EXPECT_EQ(c.registrability->overlap_share, 0.0);
+      EXPECT_EQ(c.registrability->factor, cfg.registrability.floor_share);
+      if (p == PlannerPolicy::kPaper) {
+        EXPECT_NEAR(c.score, c.f * cfg.registrability.floor_share, 1e-9 * c.f);
+      }
+    }
+    // Switched off, the plan is the paper's own.
+    cfg.registrability.enabled = false;
+    const Plan off = plan_next_scan(in, cfg);
+    const Plan alone = plan_next_scan(input(), cfg);
+    ASSERT_EQ(off.ranked.size(), alone.ranked.size());
+    for (std::size_t k = 0; k < off.ranked.size(); ++k) {
+      EXPECT_EQ(off.ranked[k].position, alone.ranked[k].position) << policy_name(p);
+    }
+  }
+}
+
 // Two robots on one map: robot A is going past the wall's end; robot B, planned next with A's
 // goal claimed, is sent elsewhere, and what A will see no longer counts for B.
 TEST_F(WallYard, AClaimedScanPointSendsTheNextRobotElsewhere) {

@@ -80,6 +80,48 @@ TEST_F(MapMatcher, ACorrectionLargerThanTheSensorsCanErrIsNotApplied) {
   EXPECT_EQ(m.placed.x, reported.x) << "a refused match leaves the reported pose";
 }
 
+// A refused match leaves x, y and yaw as reported, but the ground still fixes the height: a
+// scan left 0.4 m high would put a false step into the map.
+TEST_F(MapMatcher, ARefusedMatchIsStillSetOnTheGround) {
+  Pose reported = truth_;
+  reported.x += 0.8;
+  reported.z += 0.4;
+  MapMatchConfig c = quick();
+  c.max_correction_m = 0.3;
+  const MapMatch m = match_to_map(map_, scan_, reported, c);
+  ASSERT_FALSE(m.applied);
+  EXPECT_TRUE(m.levelled);
+  EXPECT_EQ(m.placed.x, reported.x);
+  EXPECT_EQ(m.placed.yaw, reported.yaw);
+  EXPECT_NEAR(m.placed.z, truth_.z, 0.03);
+  // Not without the option, nor beyond what the height sensor can be wrong.
+  c.level_refused = false;
+  EXPECT_EQ(match_to_map(map_, scan_, reported, c).placed.z, reported.z);
+  c.level_refused = true;
+  c.max_level_m = 0.2;
+  EXPECT_FALSE(match_to_map(map_, scan_, reported, c).levelled);
+}
+
+TEST(GroundOffset, IsTheHeightThatPutsTheScansGroundOnTheMaps) {
+  const PointCloud map = test::synthetic_yard(1);
+  const Pose truth = pose(3.0, -2.0, 0.0, 30, 1.0, -0.5);
+  const PointCloud scan = moved(test::synthetic_yard(2), truth.isometry().inverse());
+  for (const double dz : {-0.6, 0.0, 0.35}) {
+    Pose off = truth;
+    off.z += dz;
+    off.x -= 1.5;  // x-y wrong by a refused match's metre or two: the ground is flat
+    off.y += 1.0;
+    const auto found = ground_offset(map, scan, off.isometry());
+    ASSERT_TRUE(found) << dz;
+    EXPECT_NEAR(*found, -dz, 0.03) << dz;
+  }
+  // Too little shared ground: no answer.
+  Pose away = truth;
+  away.x += 200;
+  EXPECT_FALSE(ground_offset(map, scan, away.isometry()));
+  EXPECT_FALSE(ground_offset(PointCloud{}, scan, truth.isometry()));
+}
+
 TEST_F(MapMatcher, MapPointsBeyondTheRadiusAreNotUsed) {
   MapMatchConfig c = quick();
   c.target_radius_m = 1.0;  // a disc with hardly anything in it

@@ -92,6 +92,8 @@ class MissionPipeline {
   // Each scan's points in the map frame, in the order they joined.
   const std::vector<std::shared_ptr<const PointCloud>>& placed_scans() const { return placed_; }
   const MappingPipeline& mapping() const { return mapping_; }
+  // The map of the anchored scans; nothing when matching is off.
+  const MlsMap* anchored_map() const { return anchored_map_ ? &*anchored_map_ : nullptr; }
   const PlannerConfig& planner() const { return config_.planner; }
   const MissionConfig& config() const { return config_; }
   // Whether there is a map to plan on (a first scan, its regions and movable region).
@@ -102,6 +104,9 @@ class MissionPipeline {
   MappingPipeline mapping_;
   std::vector<std::shared_ptr<const PointCloud>> placed_;
   std::vector<std::uint8_t> anchored_;  // per entry of placed_
+  // The anchored scans alone, as the planner forecasts the matcher on them (PlanInput::anchored);
+  // kept only while matching is on.
+  std::optional<MlsMap> anchored_map_;
   SensorFrame sensor_frame_;
 };
 

@@ -26,11 +26,13 @@ struct FleetPlan {
 // several score within PlannerConfig::fleet_tie_share of the highest, often the same spot seen
 // from different robots, the one with the shortest drive to its own takes it, so robots do not
 // cross the site to each other's side. No robot's candidate lies where another robot stands
-// (PlanInput::occupied). With one robot this is plan_next_scan. Returns the plans
-// in the order decided; a robot whose plan is empty is decided last.
+// (PlanInput::occupied). With one robot this is plan_next_scan. `anchored` as
+// PlanInput::anchored. Returns the plans in the order decided; a robot whose plan is empty is
+// decided last.
 std::vector<FleetPlan> plan_fleet(const MlsMap& map, const TargetRegion& target,
                                   const std::vector<Eigen::Vector2d>& scan_points,
                                   const std::vector<FleetRobot>& robots,
-                                  std::vector<Eigen::Vector3d> claimed, const PlannerConfig& cfg);
+                                  std::vector<Eigen::Vector3d> claimed, const PlannerConfig& cfg,
+                                  const MlsMap* anchored = nullptr);
 
 }  // namespace scanplan

@@ -1,7 +1,10 @@
 #pragma once
 
+#include <optional>
 #include "scanplan/mapping/mls_map.hpp"
+
 #include "scanplan/mapping/region_segmentation.hpp"
+#include "scanplan/planning/registrability.hpp"
 #include "scanplan/planning/visibility.hpp"
 
 namespace scanplan {
@@ -21,16 +24,26 @@ struct ScanGain {
   // area((C_A∪M_A) seen from B): what a scan from B is predicted to see of the map so far, the
   // overlap scan matching will have to go on (issue 15). Not a term of F.
   double overlap_m2 = 0;
+  // Whether the matcher is forecast to place the scan (with an anchored map to forecast on).
+  // Not a term of F: the policies scale F by its factor.
+  std::optional<Registrability> registrability;
 };
+
+// F as the policies rank it: scaled down where the matcher is forecast to fail.
+inline double registrable_f(const ScanGain& g) {
+  return g.registrability ? g.f * g.registrability->factor : g.f;
+}
 
 // Evaluates Eq. 1 at cells of the map against one region segmentation. Cheap to call many
 // times: the visibility predictor is built once. Thread-safe with one workspace per thread.
 class ScanGainEvaluator {
  public:
   // `alpha` is the paper's weight α (§3.4), in [0, 1]; throws std::invalid_argument otherwise.
-  // `regions` must outlive the evaluator; the map is copied.
+  // `regions` (and `registrability`, when given: on the regions' grid) must outlive the
+  // evaluator; the map is copied.
   ScanGainEvaluator(const MlsMap& map, const RegionMap& regions, double alpha,
-                    const RegionConfig& region_config, const VisibilityConfig& visibility);
+                    const RegionConfig& region_config, const VisibilityConfig& visibility,
+                    const RegistrabilityField* registrability = nullptr);
 
   VisibilityPredictor::Workspace workspace() const { return predictor_.workspace(); }
   // F at the centre of cell `b`, the robot standing on a floor at `floor_z`.
@@ -42,6 +55,7 @@ class ScanGainEvaluator {
 
  private:
   const RegionMap& regions_;
+  const RegistrabilityField* registrability_;
   double alpha_;
   double completed_radius_cells2_;
   VisibilityPredictor predictor_;

@@ -10,6 +10,7 @@
 #include "scanplan/mapping/mls_map.hpp"
 #include "scanplan/mapping/movable_region.hpp"
 #include "scanplan/mapping/region_segmentation.hpp"
+#include "scanplan/planning/registrability.hpp"
 #include "scanplan/planning/visibility.hpp"
 
 namespace scanplan {
@@ -81,6 +82,10 @@ struct PlannerConfig {
   VisibilityConfig visibility;
   RegionConfig regions;
   MovableConfig movable;
+  // With an anchored map (PlanInput::anchored) each candidate carries a forecast of the scan
+  // matcher's outcome, and the paper, exhaustive and travel policies scale F down where it is
+  // forecast to fail, so the next scan stays registrable.
+  RegistrabilityConfig registrability;
 };
 
 struct Candidate {
@@ -90,7 +95,9 @@ struct Candidate {
   double gain_low_res_m2 = 0;                          // area(M_A∩C_B)
   double gain_completed_m2 = 0;  // area((U∪M_A)∩C_B): what the scan brings into C (not in F)
   double overlap_m2 = 0;         // area of the map so far seen from B (ScanGain::overlap_m2)
-  double travel_m = 0;           // path length over the movable region from the robot
+  // The forecast of the matcher's outcome there (ScanGain::registrability), when forecast.
+  std::optional<Registrability> registrability;
+  double travel_m = 0;                // path length over the movable region from the robot
   std::vector<Eigen::Vector2d> path;  // cell centres from the robot to B
   // What the policy ranked by: F (paper, random), F + completion_weight · gain_completed_m2
   // (exhaustive), F − travel_cost_per_m · F_best · max(0, travel_m − travel_free_m) (travel),
@@ -112,6 +119,10 @@ struct PlanInput {
   const std::vector<Eigen::Vector3d>* claimed = nullptr;
   // Where the other robots stand now (x, y, floor z): no candidate within robot_clearance_m.
   const std::vector<Eigen::Vector3d>* occupied = nullptr;
+  // The part of `map` the scan matcher matches against (the anchored scans; MissionPipeline),
+  // on the same cells: candidates are forecast against it (PlannerConfig::registrability).
+  // Null: no forecast (matching off, or a tool with one map).
+  const MlsMap* anchored = nullptr;
 };
 
 struct Plan {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include "scanplan/geometry/pose.hpp"
+#include "scanplan/registration/ground_level.hpp"
 #include "scanplan/registration/registration.hpp"
 
 namespace scanplan {
@@ -19,15 +20,23 @@ struct MapMatchConfig {
   // sensors are not that wrong (DESIGN.md: σ 1 m, 5°), so it would be a false match.
   double max_correction_m = 6.0;
   double max_correction_deg = 25.0;
+  // A refused match leaves x, y and yaw as reported but sets z by the ground (ground_offset),
+  // when that moves it no more than this (3σ of the reported height, DESIGN.md).
+  bool level_refused = true;
+  double max_level_m = 1.0;
+  GroundLevelConfig ground;
 };
 
 struct MapMatch {
-  Pose placed;  // where the scan goes in the map: corrected, or the reported pose on failure
+  // Where the scan goes in the map: corrected, or the reported pose on failure (its z set by
+  // the ground when `levelled`).
+  Pose placed;
   // Where the matcher's result would put the scan, applied or not (the reported pose when no
   // alignment ran): what a refused match proposed, for whoever studies the refusals.
   Pose proposed;
   RegistrationResult result;
-  bool applied = false;  // whether `placed` is the matcher's correction
+  bool applied = false;   // whether `placed` is the matcher's correction
+  bool levelled = false;  // refused, and `placed` raised or lowered onto the map's ground
 };
 
 // The pipeline hook of paper §4: the new scan (its own frame) matched against the map built so

@@ -1,0 +1,88 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "scanplan/geometry/cell_grid.hpp"
+#include "scanplan/mapping/mls_map.hpp"
+
+namespace scanplan {
+
+// Whether the scan matcher will be able to place a scan taken at a candidate point (issue 15):
+// the planner's forecast of the matcher's sanity check (AlignmentQuality: the share of the scan
+// on the map, and the weakest constraint its surfaces put on the pose). A scan the check refuses
+// keeps the pose the robot reports, metres off; a plan that goes on from there builds on sand.
+struct RegistrabilityConfig {
+  // Off: candidates are ranked by the policy's score alone (the forecast is still made).
+  bool enabled = true;
+  // A candidate is registrable when both forecasts reach these; below, it keeps the share s²
+  // of its F, s = min(overlap_share / min_overlap_share, pose_fixing / min_pose_fixing), at
+  // least floor_share. Calibrated on the campus loop against the match outcomes
+  // (docs/planner.md): below an overlap share of 0.09 no match was applied.
+  double min_overlap_share = 0.3;
+  double min_pose_fixing = 0.002;
+  double floor_share = 0.05;
+  // A cell of the anchored map holding a surface at least this deep is a wall: it fixes the
+  // pose across itself. Kerbs and low steps fix little; ground fixes only z, roll and pitch.
+  double wall_min_extent_m = 0.5;
+  // A wall's direction is that of the walls within this many cells of it.
+  int wall_radius_cells = 2;
+  // Cells nearer the scanner than this are weighted as if this far: a scan's point density
+  // falls with the square of the range, and a wall next to the scanner is not infinitely
+  // many points.
+  double near_range_m = 3.0;
+};
+
+// The forecast for one candidate.
+struct Registrability {
+  // The share of what the scan is predicted to see (weighted by the point density, 1 / r²)
+  // that lies on the anchored map: the forecast of the matcher's inlier ratio.
+  double overlap_share = 0;
+  // The weakest eigenvalue of the x, y, yaw information the anchored walls in view give,
+  // per unit of weighted overlap (yaw as a moment over the walls' RMS range, as
+  // AlignmentQuality::weakest_constraint does): near zero in a corridor or before one wall.
+  double pose_fixing = 0;
+  // The share of its score the candidate keeps (1: registrable).
+  double factor = 1;
+};
+
+// The anchored map (the scans the matcher trusts; MissionPipeline) rasterised on the planner's
+// grid: which cells it holds and, for its walls, the direction their surfaces face. Built once
+// per plan; read by many threads.
+class RegistrabilityField {
+ public:
+  RegistrabilityField(const MlsMap& anchored, CellIndex origin, int cols, int rows,
+                      const RegistrabilityConfig& config);
+
+  // Sums what a candidate sees, cell by cell (raster offsets), then forecasts.
+  class Forecast {
+   public:
+    explicit Forecast(const RegistrabilityField& field) : field_(field) {}
+    // A visible cell `o`, (di, dj) cells from the candidate's.
+    void add(std::uint32_t o, int di, int dj);
+    Registrability result() const;
+
+   private:
+    const RegistrabilityField& field_;
+    double seen_ = 0, mapped_ = 0;
+    // Weighted sums over the walls seen: Σ T, Σ T·p⊥, Σ p⊥ᵀ·T·p⊥, Σ |p|², Σ w, where T is the
+    // wall's normal tensor and p⊥ its position turned by 90° (the yaw lever).
+    double t_xx_ = 0, t_xy_ = 0, t_yy_ = 0, tp_x_ = 0, tp_y_ = 0, ptp_ = 0, r2_ = 0, walls_ = 0;
+  };
+
+  bool mapped(std::uint32_t o) const { return cells_[o].mapped != 0; }
+
+ private:
+  struct Cell {
+    // n nᵀ of the wall's normal (in the x-y plane); I/2 where the walls around have no one
+    // direction (a post, a corner); zero where there is no wall.
+    float t_xx = 0, t_xy = 0, t_yy = 0;
+    std::uint8_t mapped = 0, wall = 0;
+  };
+  RegistrabilityConfig config_;
+  double cell_m_;
+  int cols_, rows_;
+  std::vector<Cell> cells_;
+};
+
+}  // namespace scanplan

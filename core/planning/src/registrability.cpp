@@ -1,0 +1,113 @@
+#include "scanplan/planning/registrability.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+namespace scanplan {
+
+RegistrabilityField::RegistrabilityField(const MlsMap& anchored, CellIndex origin, int cols,
+                                         int rows, const RegistrabilityConfig& config)
+    : config_(config),
+      cell_m_(anchored.cell_m()),
+      cols_(cols),
+      rows_(rows),
+      cells_(static_cast<std::size_t>(cols) * static_cast<std::size_t>(rows)) {
+  for (int j = 0; j < rows; ++j) {
+    for (int i = 0; i < cols; ++i) {
+      const MlsCell* c = anchored.cell({origin.x + i, origin.y + j});
+      if (!c) continue;
+      Cell& out = cells_[static_cast<std::size_t>(j) * static_cast<std::size_t>(cols) +
+                         static_cast<std::size_t>(i)];
+      out.mapped = 1;
+      for (const SurfacePatch& p : *c) {
+        if (p.extent() >= config.wall_min_extent_m) out.wall = 1;
+      }
+    }
+  }
+  // A wall's normal is the direction across the walls around it: the minor axis of their
+  // cells' spread. Where they spread evenly (a post, a corner, a thick block) every direction
+  // is fixed alike.
+  const int r = std::max(1, config.wall_radius_cells);
+  for (int j = 0; j < rows; ++j) {
+    for (int i = 0; i < cols; ++i) {
+      Cell& w = cells_[static_cast<std::size_t>(j) * static_cast<std::size_t>(cols) +
+                       static_cast<std::size_t>(i)];
+      if (!w.wall) continue;
+      Eigen::Matrix2d spread = Eigen::Matrix2d::Zero();
+      int n = 0;
+      for (int dj = -r; dj <= r; ++dj) {
+        for (int di = -r; di <= r; ++di) {
+          const int x = i + di, y = j + dj;
+          if (x < 0 || y < 0 || x >= cols || y >= rows || di * di + dj * dj > r * r) continue;
+          if (!cells_[static_cast<std::size_t>(y) * static_cast<std::size_t>(cols) +
+                      static_cast<std::size_t>(x)]
+                   .wall) {
+            continue;
+          }
+          const Eigen::Vector2d d(di, dj);
+          spread += d * d.transpose();
+          ++n;
+        }
+      }
+      Eigen::Matrix2d t = 0.5 * Eigen::Matrix2d::Identity();
+      if (n >= 3) {
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(spread);
+        // A line of walls: its spread along is several times that across.
+        if (eig.eigenvalues()[1] > 4 * eig.eigenvalues()[0]) {
+          const Eigen::Vector2d normal = eig.eigenvectors().col(0);
+          t = normal * normal.transpose();
+        }
+      }
+      w.t_xx = static_cast<float>(t(0, 0));
+      w.t_xy = static_cast<float>(t(0, 1));
+      w.t_yy = static_cast<float>(t(1, 1));
+    }
+  }
+}
+
+void RegistrabilityField::Forecast::add(std::uint32_t o, int di, int dj) {
+  const RegistrabilityField& f = field_;
+  const double px = di * f.cell_m_, py = dj * f.cell_m_;
+  const double r2 = px * px + py * py;
+  const double near2 = f.config_.near_range_m * f.config_.near_range_m;
+  const double w = 1.0 / std::max(r2, near2);
+  seen_ += w;
+  const Cell& c = f.cells_[o];
+  if (!c.mapped) return;
+  mapped_ += w;
+  if (!c.wall) return;
+  // The wall fixes the pose along its normal n: a row (n, p⊥·n) of the x, y, yaw Jacobian,
+  // summed over the normals T = Σ n nᵀ stands for.
+  const double qx = -py, qy = px;  // p⊥
+  const double tqx = c.t_xx * qx + c.t_xy * qy, tqy = c.t_xy * qx + c.t_yy * qy;
+  t_xx_ += w * c.t_xx;
+  t_xy_ += w * c.t_xy;
+  t_yy_ += w * c.t_yy;
+  tp_x_ += w * tqx;
+  tp_y_ += w * tqy;
+  ptp_ += w * (qx * tqx + qy * tqy);
+  r2_ += w * r2;
+  walls_ += w;
+}
+
+Registrability RegistrabilityField::Forecast::result() const {
+  const RegistrabilityConfig& cfg = field_.config_;
+  Registrability out;
+  out.overlap_share = seen_ > 0 ? mapped_ / seen_ : 0.0;
+  if (walls_ > 0 && mapped_ > 0) {
+    const double L = std::max(std::sqrt(r2_ / walls_), 1e-6);
+    Eigen::Matrix3d info;
+    info << t_xx_, t_xy_, tp_x_ / L, t_xy_, t_yy_, tp_y_ / L, tp_x_ / L, tp_y_ / L, ptp_ / (L * L);
+    info /= mapped_;
+    out.pose_fixing =
+        std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(info, Eigen::EigenvaluesOnly)
+                          .eigenvalues()[0]);
+  }
+  const double share =
+      std::min(out.overlap_share / cfg.min_overlap_share, out.pose_fixing / cfg.min_pose_fixing);
+  out.factor = share >= 1 || !cfg.enabled ? 1.0 : std::max(cfg.floor_share, share * share);
+  return out;
+}
+
+}  // namespace scanplan
