@@ -34,7 +34,15 @@ test('simulate on the tree-row world', { timeout: 120000 }, () => {
         assert.equal(typeof s.match.applied, 'boolean');
         assert.equal(typeof s.match.converged, 'boolean');
         assert.equal(typeof s.match.reason, 'string');
-        if (!s.match.applied) assert.deepEqual(s.placed, s.reported);
+        // Refused: x, y and yaw as reported, z set on the map's ground (within 1 m).
+        if (!s.match.applied) {
+          for (const k of ['x', 'y', 'yaw_deg']) assert.equal(s.placed[k], s.reported[k], k);
+          assert.ok(Math.abs(s.placed.z - s.reported.z) <= 1.0, JSON.stringify(s));
+        }
+        // What the plan that sent the robot there forecast of the match.
+        assert.ok(s.forecast === null || (s.forecast.overlap_share >= 0 &&
+          s.forecast.overlap_share <= 1 && s.forecast.factor > 0 && s.forecast.factor <= 1),
+        JSON.stringify(s.forecast));
       }
     });
     assert.equal(summary.accuracy.matches_tried, n - 1);
