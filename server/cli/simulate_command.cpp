@@ -88,15 +88,20 @@ nlohmann::json forecast_json(const LoopStep* previous) {
 nlohmann::json scan_json(const LoopStep& s, const LoopStep& first, const LoopStep* previous) {
   nlohmann::json match = nullptr;
   if (s.match) {
-    match = {{"applied", s.match_applied},  {"converged", s.match->converged},
-             {"reason", s.match->message},  {"method", s.match->method},
-             {"time_ms", s.match->time_ms}, {"inlier_ratio", s.match->inlier_ratio}};
+    match = {{"applied", s.match_applied},
+             {"converged", s.match->converged},
+             {"reason", s.match->message},
+             {"method", s.match->method},
+             {"time_ms", s.match->time_ms},
+             {"inlier_ratio", s.match->inlier_ratio},
+             {"weakest_constraint", s.match->weakest_constraint}};
     // The result's own error, applied or not: a right match refused, or a wrong one applied.
     if (s.match_error_m) {
       match["error_m"] = *s.match_error_m;
       match["error_deg"] = *s.match_error_deg;
     }
     if (s.match_proposed) match["proposed"] = pose_json(*s.match_proposed);
+    match["prior"] = pose_json(s.prior_pose);
   }
   return {{"scan", s.scan},
           {"reported", pose_json(s.reported_pose)},

@@ -81,6 +81,9 @@ test('operator page: map, candidates, approval, growth by WebSocket chunk, recon
     assert.match(detail, /F \(Eq\. 1\)/);
     assert.match(detail, /gain unscanned/);
     assert.match(detail, /drive/);
+    // The planner's forecast of matching a scan there (matching is on).
+    assert.match(detail, /overlap\s+[\d,]+ m² of the map in view/);
+    assert.match(detail, /matching\s+(only )?\d+ % (of the scan )?on the trusted map/);
     t.diagnostic(`shot: ${await screenshot(page, 'operator_page.png')}`);
 
     // 3. A click on the top view proposes the operator's own point: refused where the robot cannot

@@ -98,7 +98,7 @@ test('watch prints the events of a scan; candidates agree with the REST API', as
 
   const text = await run(['candidates', '--server', stack.url, '--token', stack.viewerToken]);
   assert.equal(text.code, 0, text.stderr);
-  assert.match(text.stdout, /^rank\s+id\s+state\s+x m\s+y m\s+F\s+gain U m2\s+gain M m2\s+travel m$/m);
+  assert.match(text.stdout, /^rank\s+id\s+state\s+x m\s+y m\s+F\s+gain U m2\s+gain M m2\s+travel m\s+match$/m);
   const first = rest.candidates[0];
   assert.match(text.stdout, new RegExp(`^\\s+1\\s+${first.id}\\s+proposed\\s`, 'm'));
   const view = text.stdout.split('\n').filter((l) => /^\|.*\|$/.test(l));

@@ -6,6 +6,19 @@ import { sendJson } from './api.js';
 import { confirmAction } from './dialog.js';
 
 const nf0 = new Intl.NumberFormat('en-US', { maximumFractionDigits: 0 });
+// The planner's forecast of matching a scan at the candidate (docs/planner.md): whether the
+// scan will land on enough of the trusted map, and whether what it sees there fixes the pose.
+function matchDoubtful(c) {
+  return !!c.registrability && c.registrability.factor < 1;
+}
+function matchForecast(c) {
+  const r = c.registrability;
+  if (!r) return '';
+  const share = `${nf0.format(100 * r.overlap_share)} %`;
+  if (r.factor >= 1) return `${share} of the scan on the trusted map; it should match`;
+  if (r.overlap_share < 0.3) return `only ${share} of the scan on the trusted map: the match may fail`;
+  return `${share} on the trusted map, but few walls across: the match may slide (a corridor, one facade)`;
+}
 // signDisplay 'negative': no "-0.0" for a height just below zero.
 const nf1 = new Intl.NumberFormat('en-US', { maximumFractionDigits: 1, minimumFractionDigits: 1, signDisplay: 'negative' });
 
@@ -131,11 +144,11 @@ export class CandidatesPanel {
       row.append(
         el('span', `rank${c.custom ? ' custom' : ''}`, c.custom ? 'C' : String(c.rank)),
         el('span', 'f', `F ${nf0.format(c.f)}`),
-        el('span', 'gain', `U ${nf0.format(c.gain_unscanned_m2)} · M ${nf0.format(c.gain_low_res_m2)} m²`),
+        el('span', 'gain', `${matchDoubtful(c) ? '⚠ ' : ''}U ${nf0.format(c.gain_unscanned_m2)} · M ${nf0.format(c.gain_low_res_m2)} m²`),
         el('span', 'travel', `${nf1.format(c.travel_m)} m`),
         el('span', 'chip', STATE_TEXT[c.state] ?? c.state),
       );
-      row.title = `${candidateName(c)}${c.robot ? ` for ${c.robot}` : ''} at (${nf1.format(c.x)}, ${nf1.format(c.y)})`;
+      row.title = `${candidateName(c)}${c.robot ? ` for ${c.robot}` : ''} at (${nf1.format(c.x)}, ${nf1.format(c.y)})${matchDoubtful(c) ? ' — the scan may not match the map' : ''}`;
       row.addEventListener('click', () => this.select(c.id));
       list.append(row);
     }
@@ -153,6 +166,9 @@ export class CandidatesPanel {
       fact('gain low-res', `${nf0.format(c.gain_low_res_m2)} m²`);
       fact('drive', `${nf1.format(c.travel_m)} m`);
       fact('position', `x ${nf1.format(c.x)}, y ${nf1.format(c.y)}, z ${nf1.format(c.z)}`);
+      if (c.overlap_m2 > 0) fact('overlap', `${nf0.format(c.overlap_m2)} m² of the map in view`);
+      const forecast = matchForecast(c);
+      if (forecast) fact('matching', forecast);
       if (c.note) fact('note', c.note);
       for (const dd of grid.querySelectorAll('dd:nth-of-type(n+5)')) dd.classList.add('wide');
       detail.append(title, grid);

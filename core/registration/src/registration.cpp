@@ -226,6 +226,7 @@ RegistrationResult register_with(const PointCloud& target, const PointCloud& sou
   r.score = q.score;
   r.rmse = q.rmse;
   r.inlier_ratio = q.inlier_ratio;
+  r.weakest_constraint = q.weakest_constraint;
   if (r.converged) {
     if (std::optional<std::string> why = rejection(q, c)) {
       r.converged = false;

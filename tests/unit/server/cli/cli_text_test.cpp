@@ -37,19 +37,21 @@ json candidates_answer() {
     "candidates": [
       {"id": 12, "rank": 1, "state": "proposed", "note": "", "x": 12.34, "y": -4.56, "z": 0.1,
        "f": 1234.5, "gain_unscanned_m2": 1000, "gain_low_res_m2": 234.5, "travel_m": 15.25,
-       "score": 1200, "path": [[0, 0], [12.34, -4.56]]},
+       "score": 1200, "path": [[0, 0], [12.34, -4.56]],
+       "registrability": {"overlap_share": 0.456, "pose_fixing": 0.01, "factor": 1}},
       {"id": 13, "rank": 2, "state": "refused", "note": "rubble in the way", "x": -3, "y": 7.5,
        "z": 0, "f": 99, "gain_unscanned_m2": 50, "gain_low_res_m2": 49, "travel_m": 8,
-       "score": 90, "path": []}
+       "score": 90, "path": [],
+       "registrability": {"overlap_share": 0.12, "pose_fixing": 0.001, "factor": 0.16}}
     ]})");
 }
 
 TEST(CandidateTable, ListsRankIdStatePositionFGainsAndTravel) {
   const std::vector<std::string> expected = {
       "plan 3 after scan 2 (robot robot1, policy paper, alpha 0.50, planned in 1234 ms)",
-      "rank     id  state           x m      y m         F  gain U m2  gain M m2  travel m",
-      "   1     12  proposed       12.3     -4.6    1234.5     1000.0      234.5      15.2",
-      "   2     13  refused        -3.0      7.5      99.0       50.0       49.0       8.0  "
+      "rank     id  state           x m      y m         F  gain U m2  gain M m2  travel m  match",
+      "   1     12  proposed       12.3     -4.6    1234.5     1000.0      234.5      15.2    46%",
+      "   2     13  refused        -3.0      7.5      99.0       50.0       49.0       8.0    12%? "
       "(rubble in the way)",
   };
   EXPECT_EQ(render_candidate_table(candidates_answer()), expected);
@@ -70,13 +72,18 @@ TEST(CandidateTable, SeveralRobotsGetALineEachAndARobotColumn) {
       "plan 3 after scan 2 (robot robot1, policy paper, alpha 0.50, planned in 1234 ms)",
       "plan 4 after scan 2 (robot robot2, policy paper, alpha 0.50, planned in 100 ms)",
       "robot      rank     id  state           x m      y m         F  gain U m2  gain M m2  "
-      "travel m",
+      "travel m  match",
       "robot1        1     12  proposed       12.3     -4.6    1234.5     1000.0      234.5      "
-      "15.2",
+      "15.2    46%",
       "robot2        2     13  refused        -3.0      7.5      99.0       50.0       49.0       "
-      "8.0  (rubble in the way)",
+      "8.0    12%? (rubble in the way)",
   };
   EXPECT_EQ(render_candidate_table(answer), expected);
+  // Without a forecast (matching off, the operator's own point): a dash.
+  answer["candidates"][0].erase("registrability");
+  answer["candidates"][1]["registrability"] = nullptr;
+  const std::string row = render_candidate_table(answer)[3];
+  EXPECT_EQ(row.substr(row.size() - 2), " -") << row;
   // One robot's plan in "plans" reads as before.
   answer["plans"] = json::array({answer["plan"]});
   EXPECT_EQ(render_candidate_table(answer)[1].substr(0, 4), "rank");

@@ -28,6 +28,7 @@ struct LoopStep {
   Pose true_pose;      // where the robot really scanned
   Pose reported_pose;  // what the robot's pose sensors said
   Pose placed_pose;    // where the map put the scan (matched when matching is on)
+  Pose prior_pose;     // the reported pose carried into the map frame: where matching started
   std::optional<RegistrationResult> match;  // when the scan was matched against the map
   bool match_applied = false;               // whether placed_pose is the match's correction
   // How far the match's result was from the truth (relative to the first scan), applied or

@@ -24,8 +24,10 @@ struct RegistrationResult {
   double score = 0;
   double rmse = 0;          // over the source points whose closest target point is an inlier
   double inlier_ratio = 0;  // share of source points with a target point within the inlier distance
-  int iterations = 0;       // summed over all stages (cell sizes, NDT then ICP)
-  double time_ms = 0;       // the alignment itself: downsampling and scoring excluded
+  // The sanity check's AlignmentQuality::weakest_constraint; 0 when the solver did not settle.
+  double weakest_constraint = 0;
+  int iterations = 0;  // summed over all stages (cell sizes, NDT then ICP)
+  double time_ms = 0;  // the alignment itself: downsampling and scoring excluded
   bool converged =
       false;  // the solver stopped on its tolerances AND the result passed the sanity check
   std::string method;   // "ndt-icp", "ndt", "icp", "pcl-ndt", "pcl-icp", "pcl-gicp"
