@@ -24,6 +24,7 @@ struct SimulateArgs {
   std::uint64_t seed = 1;
   std::string match = "on";
   std::string registrability = "on";
+  RegistrabilityConfig forecast;
 };
 
 nlohmann::json optional_json(const auto& v) {
@@ -45,6 +46,7 @@ ClosedLoopConfig config_of(const SimulateArgs& a) {
   config.max_scans = a.max_scans;
   config.seed = a.seed;
   if (a.match == "off") config.matching.reset();
+  config.planner.registrability = a.forecast;
   config.planner.registrability.enabled = a.registrability == "on";
   return config;
 }
@@ -237,6 +239,14 @@ void add_simulate_command(CLI::App& app) {
                   "the planner scales down candidates the matcher is forecast to fail at (on|off)")
       ->capture_default_str()
       ->check(CLI::IsMember({"on", "off"}));
+  cmd->add_option("--min-overlap-share", args->forecast.min_overlap_share,
+                  "registrability: the overlap share below which a candidate loses score")
+      ->capture_default_str()
+      ->check(CLI::Range(0.001, 1.0));
+  cmd->add_option("--min-pose-fixing", args->forecast.min_pose_fixing,
+                  "registrability: the pose fixing below which a candidate loses score")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--out", args->out,
                   "output folder (coverage.csv, coverage.png, step_NN.png, summary.json)")
       ->required();

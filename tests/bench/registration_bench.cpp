@@ -213,7 +213,9 @@ constexpr double kPclRefineCorrespondenceM = 0.3;
 // One named method of the comparison. "ndt-icp-6dof" is ours without the inclination
 // constraint; "ndt-icp-paper-cells" ours with the paper's 20/15/10 m NDT cells as they are, not
 // scaled to the scene; "pcl-ndt+pcl-icp" is PCL's NDT refined by PCL's ICP (the PCL
-// counterpart of our combination), which reuses the pcl-ndt result of the same pair.
+// counterpart of our combination), which reuses the pcl-ndt result of the same pair;
+// "search-gicp-no-restart" search-gicp without the restart check (RegistrationConfig::
+// restart_check), the sanity check as it was calibrated.
 RegistrationResult run_method(const std::string& name, const Pair& p,
                               const RegistrationResult* pcl_ndt) {
   const RegistrationConfig& c = p.config;
@@ -233,6 +235,11 @@ RegistrationResult run_method(const std::string& name, const Pair& p,
     RegistrationConfig six = c;
     six.dof = Dof::k6;
     return register_scans(p.target, p.source, p.initial, Method::kNdtIcp, six);
+  }
+  if (name == "search-gicp-no-restart") {
+    RegistrationConfig plain = c;
+    plain.restart_check = false;
+    return register_scans(p.target, p.source, p.initial, Method::kSearchGicp, plain);
   }
   if (name == "ndt-icp-paper-cells") {
     RegistrationConfig paper = c;
@@ -407,7 +414,7 @@ std::optional<Args> parse_args(int argc, char** argv) {
   }
   for (const auto& m : a.methods) {
     if (!parse_any_method(m) && m != "ndt-icp-6dof" && m != "ndt-icp-paper-cells" &&
-        m != "pcl-ndt+pcl-icp") {
+        m != "pcl-ndt+pcl-icp" && m != "search-gicp-no-restart") {
       std::fprintf(stderr, "unknown method %s\n", m.c_str());
       return std::nullopt;
     }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "pose_increment.hpp"
+#include "scanplan/geometry/pose.hpp"
 #include "scanplan/geometry/voxel_filter.hpp"
 #include "scanplan/registration/alignment_quality.hpp"
 #include "scanplan/registration/ndt_icp.hpp"
@@ -34,8 +35,10 @@ RegistrationResult failed(std::string_view method, std::string message) {
   return r;
 }
 
-// Why a settled result is not believed (RegistrationConfig's sanity check), or nothing.
-std::optional<std::string> rejection(const AlignmentQuality& q, const RegistrationConfig& c) {
+// Why a settled result is not believed (RegistrationConfig's sanity check), or nothing; the
+// weakest constraint is not checked for a result that held on restarts.
+std::optional<std::string> rejection(const AlignmentQuality& q, const RegistrationConfig& c,
+                                     bool held_on_restart = false) {
   char buf[96];
   if (q.inlier_ratio < c.min_inlier_ratio) {
     std::snprintf(buf, sizeof buf, "%.1f%% (at least %.1f%% needed)", 100 * q.inlier_ratio,
@@ -45,7 +48,7 @@ std::optional<std::string> rejection(const AlignmentQuality& q, const Registrati
            " of the target: the scans do not overlap enough, or the match is wrong";
   }
   const double min_constraint = c.dof == Dof::k4 ? c.min_constraint : c.min_constraint_6dof;
-  if (q.weakest_constraint < min_constraint) {
+  if (q.weakest_constraint < min_constraint && !held_on_restart) {
     std::snprintf(buf, sizeof buf, "%.4f (at least %.4f needed)", q.weakest_constraint,
                   min_constraint);
     return std::string(
@@ -54,6 +57,34 @@ std::optional<std::string> rejection(const AlignmentQuality& q, const Registrati
            buf + "): a corridor or a single wall, along which the match cannot be trusted";
   }
   return std::nullopt;
+}
+
+// Whether GICP restarted from `at` shifted along x and y and turned either way comes back to it
+// every time (RegistrationConfig::restart_check).
+bool holds_on_restart(const GicpMatcher& gicp, const Eigen::Isometry3d& at,
+                      const RegistrationConfig& c) {
+  const Eigen::Vector3d pivot = at.translation();
+  const double turn = deg2rad(c.restart_turn_deg);
+  std::vector<Eigen::Isometry3d> moves;
+  for (const double s : {-c.restart_shift_m, c.restart_shift_m}) {
+    moves.emplace_back(Eigen::Translation3d(s, 0, 0));
+    moves.emplace_back(Eigen::Translation3d(0, s, 0));
+  }
+  for (const double t : {-turn, turn}) {
+    moves.emplace_back(Eigen::Translation3d(pivot) *
+                       Eigen::AngleAxisd(t, Eigen::Vector3d::UnitZ()) *
+                       Eigen::Translation3d(-pivot));
+  }
+  for (const Eigen::Isometry3d& move : moves) {
+    const RegistrationResult r = gicp.align(move * at, c.dof);
+    const Eigen::Isometry3d off = at.inverse() * r.transform;
+    // A turn's error shows as a shift at the scan's reach; the shift is the tolerance's measure.
+    if (!r.converged || off.translation().norm() > c.restart_tolerance_m ||
+        Eigen::AngleAxisd(off.linear()).angle() > c.restart_tolerance_m / 20.0) {
+      return false;
+    }
+  }
+  return true;
 }
 
 // GICP from the peaks of the pose search, best first (from `initial` when the search finds
@@ -72,6 +103,7 @@ RegistrationResult align_search_gicp(const PointCloud& target, const PointCloud&
   std::vector<PoseHypothesis> starts = search_poses(target, source, initial, c.search);
   if (starts.empty()) starts.push_back({initial, 0});
   RegistrationResult best;
+  AlignmentQuality best_q;
   int best_rank = -1;
   std::size_t best_inliers = 0;
   int iterations = 0;
@@ -83,10 +115,15 @@ RegistrationResult align_search_gicp(const PointCloud& target, const PointCloud&
     const int rank = r.converged ? (rejection(q, c) ? 1 : 2) : 0;
     if (rank > best_rank || (rank == best_rank && q.inliers > best_inliers)) {
       best = std::move(r);
+      best_q = q;
       best_rank = rank;
       best_inliers = q.inliers;
     }
     if (best_rank == 2) break;
+  }
+  // Refused only for its weakest constraint: restarts from around it tell whether it holds.
+  if (best_rank == 1 && c.restart_check && !rejection(best_q, c, /*held_on_restart=*/true)) {
+    best.held_on_restart = holds_on_restart(gicp, best.transform, c);
   }
   best.iterations = iterations;
   return best;
@@ -153,6 +190,8 @@ RegistrationConfig scale_lengths(const RegistrationConfig& config, double factor
     stage.max_correspondence_m *= factor;
   }
   c.gicp.translation_tolerance_m *= factor;
+  c.restart_shift_m *= factor;
+  c.restart_tolerance_m *= factor;
   c.search.cell_m *= factor;
   c.search.source_voxel_m *= factor;
   c.inlier_distance_m *= factor;
@@ -228,9 +267,14 @@ RegistrationResult register_with(const PointCloud& target, const PointCloud& sou
   r.inlier_ratio = q.inlier_ratio;
   r.weakest_constraint = q.weakest_constraint;
   if (r.converged) {
-    if (std::optional<std::string> why = rejection(q, c)) {
+    if (std::optional<std::string> why = rejection(q, c, r.held_on_restart)) {
       r.converged = false;
       r.message = std::move(*why);
+    } else if (r.held_on_restart && rejection(q, c)) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%.4f", q.weakest_constraint);
+      r.message = std::string("the surfaces fix the pose only weakly (weakest constraint ") + buf +
+                  "), but GICP restarted around the result came back to it each time";
     }
   }
   return r;

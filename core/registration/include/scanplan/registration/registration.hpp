@@ -83,6 +83,15 @@ struct RegistrationConfig {
   double min_inlier_ratio = 0.03;
   double min_constraint = 0.03;
   double min_constraint_6dof = 0.01;
+  // search-gicp: a result refused for its weakest constraint alone is believed after all when
+  // GICP restarted from it moved restart_shift_m along x and y and turned restart_turn_deg
+  // either way comes back within restart_tolerance_m each time: the weakest-constraint number
+  // counts every matched point, the ground's too, and small overlaps with a few walls across
+  // score low although they fix the pose; a pose the surfaces leave free stays where it is put.
+  bool restart_check = true;
+  double restart_shift_m = 1.0;
+  double restart_turn_deg = 2.0;
+  double restart_tolerance_m = 0.05;
   // Fewer points than this in either cloud after thinning: no match is attempted.
   std::size_t min_points = 30;
 };

@@ -26,6 +26,9 @@ struct RegistrationResult {
   double inlier_ratio = 0;  // share of source points with a target point within the inlier distance
   // The sanity check's AlignmentQuality::weakest_constraint; 0 when the solver did not settle.
   double weakest_constraint = 0;
+  // The weakest constraint was below the check's, but restarts from around the result all came
+  // back to it (RegistrationConfig::restart_check), so it was believed.
+  bool held_on_restart = false;
   int iterations = 0;  // summed over all stages (cell sizes, NDT then ICP)
   double time_ms = 0;  // the alignment itself: downsampling and scoring excluded
   bool converged =
