@@ -122,7 +122,8 @@ RegistrationResult align_search_gicp(const PointCloud& target, const PointCloud&
     if (best_rank == 2) break;
   }
   // Refused only for its weakest constraint: restarts from around it tell whether it holds.
-  if (best_rank == 1 && c.restart_check && !rejection(best_q, c, /*held_on_restart=*/true)) {
+  if (best_rank == 1 && c.restart_check && best_q.weakest_constraint >= c.restart_min_constraint &&
+      !rejection(best_q, c, /*held_on_restart=*/true)) {
     best.held_on_restart = holds_on_restart(gicp, best.transform, c);
   }
   best.iterations = iterations;
