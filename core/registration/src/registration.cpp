@@ -78,9 +78,8 @@ bool holds_on_restart(const GicpMatcher& gicp, const Eigen::Isometry3d& at,
   for (const Eigen::Isometry3d& move : moves) {
     const RegistrationResult r = gicp.align(move * at, c.dof);
     const Eigen::Isometry3d off = at.inverse() * r.transform;
-    // A turn's error shows as a shift at the scan's reach; the shift is the tolerance's measure.
     if (!r.converged || off.translation().norm() > c.restart_tolerance_m ||
-        Eigen::AngleAxisd(off.linear()).angle() > c.restart_tolerance_m / 20.0) {
+        Eigen::AngleAxisd(off.linear()).angle() > deg2rad(c.restart_tolerance_deg)) {
       return false;
     }
   }

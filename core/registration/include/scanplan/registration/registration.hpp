@@ -85,8 +85,8 @@ struct RegistrationConfig {
   double min_constraint_6dof = 0.01;
   // search-gicp: a result refused for its weakest constraint alone is believed after all when
   // GICP restarted from it moved restart_shift_m along x and y and turned restart_turn_deg
-  // either way comes back within restart_tolerance_m each time: the weakest-constraint number
-  // counts every matched point, the ground's too, and small overlaps with a few walls across
+  // either way comes back within restart_tolerance_m and _deg each time: the weakest-constraint
+  // number counts every matched point, the ground's too, and small overlaps with a few walls across
   // score low although they fix the pose; a pose the surfaces leave free stays where it is put.
   // Below restart_min_constraint a result is refused whatever the restarts say: there GICP creeps
   // back along the nearly free direction within the tolerance (2 of 290 loop matches at 0.0041
@@ -96,6 +96,7 @@ struct RegistrationConfig {
   double restart_shift_m = 1.0;
   double restart_turn_deg = 2.0;
   double restart_tolerance_m = 0.05;
+  double restart_tolerance_deg = 0.15;  // 5 cm at 20 m
   // Fewer points than this in either cloud after thinning: no match is attempted.
   std::size_t min_points = 30;
 };
