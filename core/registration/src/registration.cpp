@@ -121,8 +121,9 @@ RegistrationResult align_search_gicp(const PointCloud& target, const PointCloud&
     if (best_rank == 2) break;
   }
   // Refused only for its weakest constraint: restarts from around it tell whether it holds.
+  const double shift = (best.transform.translation() - initial.translation()).head<2>().norm();
   if (best_rank == 1 && c.restart_check && best_q.weakest_constraint >= c.restart_min_constraint &&
-      !rejection(best_q, c, /*held_on_restart=*/true)) {
+      shift <= c.restart_max_shift_m && !rejection(best_q, c, /*held_on_restart=*/true)) {
     best.held_on_restart = holds_on_restart(gicp, best.transform, c);
   }
   best.iterations = iterations;

@@ -91,8 +91,13 @@ struct RegistrationConfig {
   // Below restart_min_constraint a result is refused whatever the restarts say: there GICP creeps
   // back along the nearly free direction within the tolerance (2 of 290 loop matches at 0.0041
   // passed 2–3 m off; the right ones start at 0.006, one at 0.0034).
+  // Nor is it believed farther than restart_max_shift_m (x-y) from where the match started: weak
+  // evidence only where the pose sensors agree (4σ of their 1 m; in the loop the right results
+  // it took lay within 3.7 m, a wrong one 5 m off held on restarts in a repeated facade). Not
+  // scaled with the scene: it is the sensors'.
   bool restart_check = true;
   double restart_min_constraint = 0.005;
+  double restart_max_shift_m = 4.0;
   double restart_shift_m = 1.0;
   double restart_turn_deg = 2.0;
   double restart_tolerance_m = 0.05;
