@@ -119,7 +119,7 @@ LoopResult run_closed_loop(
       ground = reachable_ground_cells(world, trav, start_reach, pipeline.map(), map_from_world);
       result.reachable_cells = ground.size();
     }
-    step.prior_pose = scan == 1 ? step.reported_pose : mission.prior(step.reported_pose);
+    step.prior_pose = mission.prior(step.reported_pose);  // the reported pose before any anchor
     if (const auto m = mission.place(cloud, step.reported_pose)) {
       step.match = m->result;
       step.match_applied = m->applied;

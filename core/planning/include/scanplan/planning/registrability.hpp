@@ -70,8 +70,6 @@ class RegistrabilityField {
     double t_xx_ = 0, t_xy_ = 0, t_yy_ = 0, tp_x_ = 0, tp_y_ = 0, ptp_ = 0, r2_ = 0, walls_ = 0;
   };
 
-  bool mapped(std::uint32_t o) const { return cells_[o].mapped != 0; }
-
  private:
   struct Cell {
     // n nᵀ of the wall's normal (in the x-y plane); I/2 where the walls around have no one
