@@ -35,6 +35,20 @@ json match_json(const std::optional<StoredMatch>& m) {
 
 }  // namespace
 
+json not_in_map_json(const std::vector<ScanIntake::NotInMap>& scans) {
+  json out = json::array();
+  for (const auto& s : scans)
+    out.push_back({{"id", s.id}, {"robot", s.robot}, {"reason", s.reason}});
+  return out;
+}
+
+json dropped_json(const DroppedReturns& d) {
+  return {{"non_finite", d.non_finite},
+          {"out_of_range", d.out_of_range},
+          {"mount", d.mount},
+          {"saturated", d.saturated}};
+}
+
 json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas) {
   return {{"id", s.id},
           {"robot", s.robot},

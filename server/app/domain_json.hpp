@@ -9,6 +9,8 @@
 #include "app/mission.hpp"
 #include "app/plan_book.hpp"
 #include "app/robot_board.hpp"
+#include "app/scan_intake.hpp"
+#include "scanplan/geometry/scan_returns.hpp"
 #include "scanplan/registration/map_matcher.hpp"
 #include "storage/session_store.hpp"
 
@@ -20,6 +22,10 @@ namespace scanplan::server {
 nlohmann::json pose_json(const Pose& p);  // {x, y, z, yaw_deg}
 nlohmann::json areas_json(const MapAreas& a);
 nlohmann::json layer_geometry_json(const LayerGeometry& g);
+// Scans the session holds that are not in the map, and why: [{id, robot, reason}].
+nlohmann::json not_in_map_json(const std::vector<ScanIntake::NotInMap>& scans);
+// What drop_bad_returns left out of a scan, by kind.
+nlohmann::json dropped_json(const DroppedReturns& d);
 nlohmann::json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas);
 nlohmann::json candidate_json(const CandidateRecord& r, const std::string& robot,
                               std::uint64_t plan);

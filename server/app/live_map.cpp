@@ -307,10 +307,22 @@ MissionParams LiveMap::params() const {
 
 void LiveMap::set_params(const MissionParams& params) {
   std::lock_guard encode_lock(encode_mutex_);
-  claim_separation_m_ = params.planner.claim_separation_m;
-  mission_.set_planner(params.planner);
-  if (params.target) mission_.set_target(*params.target);
-  const auto plans = refresh_derived({});
+  const MissionParams before{mission_.planner(), mission_.mapping().target()};
+  const auto apply = [&](const MissionParams& p) {
+    claim_separation_m_ = p.planner.claim_separation_m;
+    mission_.set_planner(p.planner);
+    if (p.target) mission_.set_target(*p.target);
+    return refresh_derived({});
+  };
+  std::vector<PlanRecord> plans;
+  try {
+    plans = apply(params);
+  } catch (...) {
+    // All or nothing: a region the machine cannot segment (out of memory) leaves the mission
+    // as it was, not half changed and failing every later scan.
+    apply(before);
+    throw;
+  }
   if (on_plan) {
     for (const PlanRecord& plan : plans) on_plan(plan);
   }

@@ -1,6 +1,9 @@
 #include "app/scan_intake.hpp"
 
 #include "app/domain_json.hpp"
+#include "common/iso_time.hpp"
+#include "common/text_fields.hpp"
+#include "scanplan/geometry/pose_limits.hpp"
 #include "scanplan/geometry/scan_returns.hpp"
 
 #include <spdlog/spdlog.h>
@@ -24,19 +27,38 @@ void ScanIntake::start() {
   }
   // Taken before anything can submit, so no scan is both on this list and in the queue.
   std::vector<StoredScan> existing = session_.scans();
+  {
+    std::lock_guard lock(mutex_);
+    if (!existing.empty()) rebuild_ = Rebuild{0, existing.size()};
+  }
   worker_ = std::thread([this, existing = std::move(existing)] {
     // A restarted server rebuilds its map from the session on disk, scan by scan, while it
-    // already answers requests.
+    // already answers requests (and says so: rebuilding()).
     for (const StoredScan& s : existing) {
       {
         std::lock_guard lock(mutex_);
         if (stop_) return;
       }
-      try {
-        process(s, session_.load_points(s));
-      } catch (const std::exception& e) {
-        spdlog::error("scan {} of the session cannot be read back: {}", s.id, e.what());
+      std::string problem;
+      if (const auto why = implausible_pose(s.placed)) {
+        problem = "its stored pose is not a place: " + *why;
+      } else {
+        try {
+          process(s, session_.load_points(s));
+        } catch (const std::exception& e) {
+          problem = e.what();
+        }
       }
+      std::lock_guard lock(mutex_);
+      if (!problem.empty()) {
+        spdlog::error("scan {} of the session cannot be brought back: {}", s.id, problem);
+        not_in_map_.push_back({s.id, s.robot, problem});
+      }
+      ++rebuild_->done;
+    }
+    {
+      std::lock_guard lock(mutex_);
+      rebuild_.reset();
     }
     loop();
   });
@@ -51,23 +73,35 @@ void ScanIntake::stop() {
   if (worker_.joinable()) worker_.join();
 }
 
-StoredScan ScanIntake::submit(const std::string& robot, const Pose& estimated,
-                              std::int64_t stamp_ns, PointCloud cloud) {
+SubmittedScan ScanIntake::submit(const std::string& robot, const Pose& estimated,
+                                 std::int64_t stamp_ns, PointCloud cloud) {
+  const auto refuse = [&](auto error) {
+    spdlog::warn("scan from '{}' refused: {}", robot, error.what());
+    events_.publish("scan_rejected", {{"robot", robot}, {"reason", error.what()}});
+    throw error;
+  };
+  if (const auto why = robot_id_problem(robot)) refuse(InvalidScanError(*why));
+  if (const auto why = implausible_pose(estimated)) refuse(InvalidScanError(*why));
   // The laser sits sensor_height_m above the origin of the robot frame our scans use; data
   // recorded about the laser itself (a 3DTK replay) shows it by a saturation shell there.
   ReturnFilterConfig returns;
   const Eigen::Vector3f robot_frame(0, 0, static_cast<float>(live_.sensor_height_m()));
   returns.sensor = locate_sensor(cloud, {robot_frame, Eigen::Vector3f::Zero()}, returns);
   const DroppedReturns dropped = drop_bad_returns(cloud, returns);
-  if (cloud.empty()) {
-    throw UnusableScanError(
-        "no point of the scan is usable: " + std::to_string(dropped.non_finite) + " not finite, " +
-        std::to_string(dropped.mount) + " on the scanner's mount, " +
-        std::to_string(dropped.saturated) + " in a saturation shell");
+  if (cloud.size() < kMinScanPoints) {
+    refuse(UnusableScanError(std::to_string(cloud.size()) +
+                             " of the scan's points are measurements, at least " +
+                             std::to_string(kMinScanPoints) +
+                             " are needed (dropped: " + std::to_string(dropped.non_finite) +
+                             " not finite, " + std::to_string(dropped.out_of_range) + " beyond " +
+                             std::to_string(static_cast<int>(returns.max_range_m)) + " m, " +
+                             std::to_string(dropped.mount) + " on the scanner's mount, " +
+                             std::to_string(dropped.saturated) + " in a saturation shell)"));
   }
   if (dropped.total() > 0) {
-    spdlog::info("scan from '{}': dropped {} not finite, {} on the mount, {} saturated", robot,
-                 dropped.non_finite, dropped.mount, dropped.saturated);
+    spdlog::info(
+        "scan from '{}': dropped {} not finite, {} out of range, {} on the mount, {} saturated",
+        robot, dropped.non_finite, dropped.out_of_range, dropped.mount, dropped.saturated);
   }
   // Matching will correct `placed`; until then the reported pose is the best there is.
   StoredScan stored = session_.add_scan(robot, estimated, estimated, stamp_ns, cloud);
@@ -79,11 +113,8 @@ StoredScan ScanIntake::submit(const std::string& robot, const Pose& estimated,
   events_.publish("scan_received", {{"scan", stored.id},
                                     {"robot", robot},
                                     {"points", stored.points},
-                                    {"dropped",
-                                     {{"non_finite", dropped.non_finite},
-                                      {"mount", dropped.mount},
-                                      {"saturated", dropped.saturated}}}});
-  return stored;
+                                    {"dropped", dropped_json(dropped)}});
+  return {stored, dropped};
 }
 
 StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
@@ -97,7 +128,20 @@ StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
                            m.result.time_ms, m.result.inlier_ratio};
   // Refused, the match leaves the scan at its reported pose carried into the map frame.
   scan.placed = p;
-  session_.record_match(scan.id, *scan.match, p);
+  try {
+    session_.record_match(scan.id, *scan.match, p);
+  } catch (const SessionStoreError& failure) {
+    // The scan was acknowledged: it joins the map whatever the disk says; a restart would
+    // bring it back at its reported pose.
+    const std::string message = "the match of scan " + std::to_string(scan.id) +
+                                " could not be recorded in the session: " + failure.what();
+    spdlog::error("{}", message);
+    {
+      std::lock_guard lock(mutex_);
+      storage_failure_ = StorageFailure{iso8601_utc_now(), message};
+    }
+    events_.publish("storage_failed", {{"scan", scan.id}, {"message", message}});
+  }
   events_.publish("match_done", match_done_json(scan.id, e, m));
   if (!m.applied) {
     spdlog::warn("scan {} stays at its reported pose (in the map frame): {}", scan.id,
@@ -130,6 +174,21 @@ std::size_t ScanIntake::pending() const {
   return queue_.size();
 }
 
+std::vector<ScanIntake::NotInMap> ScanIntake::not_in_map() const {
+  std::lock_guard lock(mutex_);
+  return not_in_map_;
+}
+
+std::optional<ScanIntake::Rebuild> ScanIntake::rebuilding() const {
+  std::lock_guard lock(mutex_);
+  return rebuild_;
+}
+
+std::optional<ScanIntake::StorageFailure> ScanIntake::last_storage_failure() const {
+  std::lock_guard lock(mutex_);
+  return storage_failure_;
+}
+
 void ScanIntake::loop() {
   for (;;) {
     std::pair<StoredScan, PointCloud> next;
@@ -147,6 +206,8 @@ void ScanIntake::loop() {
                    next.first.placed.y, next.first.placed.z);
     } catch (const std::exception& e) {
       spdlog::error("scan {} could not join the map: {}", next.first.id, e.what());
+      std::lock_guard lock(mutex_);
+      not_in_map_.push_back({next.first.id, next.first.robot, e.what()});
     }
     std::lock_guard lock(mutex_);
     queue_.pop_front();

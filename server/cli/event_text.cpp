@@ -42,13 +42,18 @@ std::string scan_received(const json& e) {
                      " stored: " + str(e, "points") + " points";
   const auto d = e.find("dropped");
   if (d == e.end() || !d->is_object()) return text;
-  const double non_finite = num(*d, "non_finite"), mount = num(*d, "mount"),
-               saturated = num(*d, "saturated");
-  if (non_finite + mount + saturated > 0) {
-    text += " (dropped " + fixed(non_finite, 0) + " not finite, " + fixed(mount, 0) +
-            " on the mount, " + fixed(saturated, 0) + " saturated)";
+  const double non_finite = num(*d, "non_finite"), out_of_range = num(*d, "out_of_range"),
+               mount = num(*d, "mount"), saturated = num(*d, "saturated");
+  if (non_finite + out_of_range + mount + saturated > 0) {
+    text += " (dropped " + fixed(non_finite, 0) + " not finite, ";
+    if (out_of_range > 0) text += fixed(out_of_range, 0) + " out of range, ";
+    text += fixed(mount, 0) + " on the mount, " + fixed(saturated, 0) + " saturated)";
   }
   return text;
+}
+
+std::string scan_rejected(const json& e) {
+  return "scan from " + str(e, "robot") + " REFUSED: " + str(e, "reason");
 }
 
 std::string match_done(const json& e) {
@@ -125,6 +130,7 @@ std::string describe_event(const json& e) {
     return with_message(text, e);
   }
   if (type == "scan_received") return scan_received(e);
+  if (type == "scan_rejected") return scan_rejected(e);
   if (type == "match_done") return match_done(e);
   if (type == "map_updated") {
     return "scan " + str(e, "scan") + " is in the map: completed " +

@@ -54,7 +54,10 @@ ReadScan read_scan(const std::string& file, const char* role, const RegisterArgs
 }
 
 nlohmann::ordered_json dropped_json(const DroppedReturns& d) {
-  return {{"non_finite", d.non_finite}, {"mount", d.mount}, {"saturated", d.saturated}};
+  return {{"non_finite", d.non_finite},
+          {"out_of_range", d.out_of_range},
+          {"mount", d.mount},
+          {"saturated", d.saturated}};
 }
 
 void run_register(const RegisterArgs& a) {

@@ -546,7 +546,7 @@ void DdsLink::store_scan(AssembledScan& s) {
       awaited_.erase(it);
   }
   try {
-    const StoredScan r = intake_.submit(robot, s.pose, s.stamp_ns, std::move(cloud));
+    const StoredScan r = intake_.submit(robot, s.pose, s.stamp_ns, std::move(cloud)).scan;
     spdlog::info("scan {} from '{}' stored: {} points", r.id, robot, r.points);
   } catch (const std::exception& e) {
     spdlog::error("could not store a scan from '{}': {}", robot, e.what());

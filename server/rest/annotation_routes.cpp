@@ -45,16 +45,7 @@ Response Api::post_annotation(const Request& request) {
   const std::string kind = body["kind"].get<std::string>();
   const double x = rest::coordinate(body, "x"), y = rest::coordinate(body, "y"),
                z = rest::coordinate(body, "z");
-  std::string text;
-  if (body.contains("text")) {
-    if (!body["text"].is_string()) throw HttpError(400, "bad_request", "'text' must be a string");
-    text = body["text"].get<std::string>();
-  }
-  if (text.size() > kMaxAnnotationTextBytes) {
-    throw HttpError(400, "bad_request",
-                    "'text' is too long: " + std::to_string(text.size()) + " bytes, at most " +
-                        std::to_string(kMaxAnnotationTextBytes));
-  }
+  const std::string text = rest::text_in(body, "text", kMaxAnnotationTextBytes, TextKind::kProse);
   if (kind == "note" && text.empty()) {
     throw HttpError(400, "bad_request", "'text' is required for a note");
   }

@@ -125,6 +125,18 @@ Response Api::session(const Request& request) const {
             {"role", auth_.role_of(request) == Role::kOperator ? "operator" : "viewer"}};
   j["areas"] = areas_json(app_.map.areas());
   if (const auto g = app_.map.layer_geometry()) j["layers"] = layer_geometry_json(*g);
+  // A reopened session is not an empty one: its scans are coming back.
+  if (const auto r = app_.intake.rebuilding()) {
+    j["rebuilding"] = {{"done", r->done}, {"total", r->total}};
+  } else {
+    j["rebuilding"] = nullptr;
+  }
+  j["scans_not_in_map"] = not_in_map_json(app_.intake.not_in_map());
+  if (const auto f = app_.intake.last_storage_failure()) {
+    j["storage_failure"] = {{"at", f->at}, {"message", f->message}};
+  } else {
+    j["storage_failure"] = nullptr;
+  }
   if (last) {
     const Bounds3 b = app_.map.bounds();
     j["bounds"] = {{"min", {b.min.x(), b.min.y(), b.min.z()}},

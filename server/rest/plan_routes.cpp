@@ -47,7 +47,7 @@ Response Api::candidates(const Request& request) const {
   std::vector<PlanRecord> plans;
   const auto robot = request.query.find("robot");
   if (robot != request.query.end()) {
-    if (auto p = app_.plans.plan(robot->second)) plans.push_back(std::move(*p));
+    if (auto p = app_.plans.plan(rest::robot_in(robot->second))) plans.push_back(std::move(*p));
   } else {
     plans = app_.plans.plans();
     if (const auto latest = app_.plans.plan()) {
@@ -75,14 +75,7 @@ Response Api::decide(const Request& request, const std::string& id, const std::s
                              "the body, when given, is {\"by\": \"name\", \"reason\": \"...\"}");
   }
   const std::string by = rest::decided_by(body);
-  std::string reason;
-  if (body.contains("reason") && body["reason"].is_string()) {
-    reason = body["reason"].get<std::string>();
-    if (reason.size() > kMaxReasonBytes) {
-      throw HttpError(400, "bad_request",
-                      "'reason' is limited to " + std::to_string(kMaxReasonBytes) + " bytes");
-    }
-  }
+  const std::string reason = rest::text_in(body, "reason", kMaxReasonBytes, TextKind::kProse);
   try {
     if (action == "approve") return Response::json(200, approval_json(app_.mission.approve(n, by)));
     if (action == "reject") {
@@ -121,6 +114,7 @@ Response Api::post_goal(const Request& request) {
   if (body.contains("robot")) {
     if (!body["robot"].is_string()) throw HttpError(400, "bad_request", "'robot' is a string");
     robot = body["robot"].get<std::string>();
+    if (!robot.empty()) rest::robot_in(robot);
   }
   try {
     const Proposal p = app_.mission.propose(x, y, robot, rest::decided_by(body));
@@ -187,9 +181,13 @@ Response Api::put_params(const Request& request) {
       std::vector<Eigen::Vector2d> corners;
       if (value.is_array()) {
         for (const auto& c : value) {
-          if (!c.is_array() || c.size() != 2 || !c[0].is_number() || !c[1].is_number()) {
-            corners.clear();
-            break;
+          if (!c.is_array() || c.size() != 2 || !c[0].is_number() || !c[1].is_number() ||
+              std::abs(c[0].get<double>()) > rest::kMaxCoordinateM ||
+              std::abs(c[1].get<double>()) > rest::kMaxCoordinateM) {
+            throw HttpError(400, "bad_request",
+                            "'target' must be [[x, y], ...]: corners of finite metres within ±" +
+                                std::to_string(static_cast<long>(rest::kMaxCoordinateM)) +
+                                ", got " + c.dump().substr(0, 80));
           }
           corners.emplace_back(c[0].get<double>(), c[1].get<double>());
         }
@@ -197,14 +195,15 @@ Response Api::put_params(const Request& request) {
       try {
         p.target = TargetRegion::polygon(corners);
       } catch (const std::invalid_argument& e) {
-        throw HttpError(
-            400, "bad_request",
-            std::string("'target' must be [[x, y], ...] with at least 3 corners: ") + e.what());
+        throw HttpError(400, "bad_request",
+                        std::string("'target' is not a region the planner can take: ") + e.what());
       }
     } else {
       throw HttpError(400, "bad_request", "unknown parameter '" + key + "'");
     }
   }
+  // Every value is checked above, so a failure here is the machine's (memory); set_params then
+  // leaves the parameters as they were.
   app_.map.set_params(p);
   return Response::json(200, params_json(app_.map.params()));
 }

@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <string_view>
 
 #include "http/http_error.hpp"
 
@@ -23,22 +24,48 @@ std::int64_t query_scan_id(const Request& r, const std::string& name) {
   return id;
 }
 
+namespace {
+
+// A plain decimal number: [+-]digits[.digits][(e|E)[+-]digits], at least one digit before the
+// exponent. No hex floats, "inf", "nan" or spaces, which strtod would take.
+bool is_decimal(std::string_view v) {
+  std::size_t i = 0, digits = 0;
+  const auto run = [&] {
+    std::size_t n = 0;
+    while (i < v.size() && v[i] >= '0' && v[i] <= '9') ++i, ++n;
+    return n;
+  };
+  if (i < v.size() && (v[i] == '+' || v[i] == '-')) ++i;
+  digits += run();
+  if (i < v.size() && v[i] == '.') {
+    ++i;
+    digits += run();
+  }
+  if (digits == 0) return false;
+  if (i < v.size() && (v[i] == 'e' || v[i] == 'E')) {
+    ++i;
+    if (i < v.size() && (v[i] == '+' || v[i] == '-')) ++i;
+    if (run() == 0) return false;
+  }
+  return i == v.size();
+}
+
+}  // namespace
+
 double query_number(const Request& r, const std::string& name) {
   const auto it = r.query.find(name);
   if (it == r.query.end()) {
     throw HttpError(400, "bad_request", "query parameter '" + name + "' is required");
   }
-  std::size_t used = 0;
+  const std::string& text = it->second;
   double v = 0;
-  try {
-    v = std::stod(it->second, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != it->second.size() || !std::isfinite(v)) {
-    throw HttpError(
-        400, "bad_request",
-        "query parameter '" + name + "' must be a finite number, got '" + it->second + "'");
+  const char* begin = text.data() + (text.starts_with('+') ? 1 : 0);
+  const auto [end, ec] = std::from_chars(begin, text.data() + text.size(), v);
+  if (!is_decimal(text) || ec != std::errc() || end != text.data() + text.size() ||
+      !std::isfinite(v)) {
+    throw HttpError(400, "bad_request",
+                    "query parameter '" + name + "' must be a finite decimal number, got '" +
+                        text.substr(0, 64) + "'");
   }
   return v;
 }
@@ -98,23 +125,42 @@ double coordinate(const json& body, const char* key) {
 }
 
 std::string decided_by(const json& body) {
-  if (body.is_object() && body.contains("by") && body["by"].is_string()) {
+  if (body.is_object() && body.contains("by")) {
+    if (!body["by"].is_string()) throw HttpError(400, "bad_request", "'by' must be a name");
     std::string name = body["by"].get<std::string>();
-    if (name.size() > 100) {
-      throw HttpError(400, "bad_request", "'by' is limited to 100 bytes");
+    if (const auto why = text_problem(name, "by", 100, TextKind::kLine)) {
+      throw HttpError(400, "bad_request", *why);
     }
     if (!name.empty()) return "operator " + name;
   }
   return "operator";
 }
 
+std::string text_in(const json& body, const char* key, std::size_t max_bytes, TextKind kind) {
+  if (!body.contains(key)) return {};
+  if (!body[key].is_string()) {
+    throw HttpError(400, "bad_request", std::string("'") + key + "' must be a string");
+  }
+  std::string text = body[key].get<std::string>();
+  if (const auto why = text_problem(text, key, max_bytes, kind)) {
+    throw HttpError(400, "bad_request", *why);
+  }
+  return text;
+}
+
+std::string robot_in(const std::string& text) {
+  if (const auto why = robot_id_problem(text)) throw HttpError(400, "bad_request", *why);
+  return text;
+}
+
 std::string author_of(const json& body, std::size_t max_bytes) {
   if (!body.is_object() || !body.contains("by")) return "operator";
   const json& by = body.at("by");
   if (!by.is_string() || by.get<std::string>().empty() ||
-      by.get<std::string>().size() > max_bytes) {
-    throw HttpError(400, "bad_request",
-                    "'by' must be a name of 1 to " + std::to_string(max_bytes) + " bytes");
+      text_problem(by.get<std::string>(), "by", max_bytes, TextKind::kLine)) {
+    throw HttpError(
+        400, "bad_request",
+        "'by' must be a name of 1 to " + std::to_string(max_bytes) + " bytes on one line");
   }
   return "operator " + by.get<std::string>();
 }

@@ -4,7 +4,9 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "common/text_fields.hpp"
 #include "http/request.hpp"
+#include "scanplan/geometry/pose_limits.hpp"
 
 // Reading requests: each function throws http::HttpError 400 naming what is wrong.
 namespace scanplan::server::rest {
@@ -24,12 +26,17 @@ double coordinate(const nlohmann::json& body, const char* key);
 // Who decided, for decisions and goals: "operator", or "operator NAME" when the body names one
 // (at most 100 bytes; an empty name counts as none).
 std::string decided_by(const nlohmann::json& body);
+// body[key] as text checked by text_problem; empty when the body has no such key.
+std::string text_in(const nlohmann::json& body, const char* key, std::size_t max_bytes,
+                    TextKind kind);
+// `text` when it is a robot id (robot_id_problem), else 400.
+std::string robot_in(const std::string& text);
 // Who acts, recorded as decisions are: "operator", or "operator NAME" for the body's "by"
 // (1 to `max_bytes` bytes).
 std::string author_of(const nlohmann::json& body, std::size_t max_bytes = 64);
 
 // A coordinate beyond this is a unit mistake (millimetres, a GPS longitude in the wrong field),
-// not a place.
-inline constexpr double kMaxCoordinateM = 1e6;
+// not a place: PoseLimits::max_xy_m, the bound on the poses scans come with.
+inline constexpr double kMaxCoordinateM = PoseLimits{}.max_xy_m;
 
 }  // namespace scanplan::server::rest

@@ -5,6 +5,7 @@
 
 #include "app/domain_json.hpp"
 #include "app/scan_intake.hpp"
+#include "common/text_fields.hpp"
 #include "http/http_error.hpp"
 #include "rest/request_parsing.hpp"
 #include "scanplan/io/scan_file.hpp"
@@ -77,9 +78,7 @@ Response Api::post_scan(const Request& request) {
   estimated.yaw = deg2rad(query_number(request, "yaw_deg"));
   std::string robot = "robot1";
   if (const auto it = request.query.find("robot"); it != request.query.end()) robot = it->second;
-  if (robot.empty() || robot.size() > 64 || robot.find('/') != std::string::npos) {
-    throw HttpError(400, "bad_request", "'robot' must be 1 to 64 characters without '/'");
-  }
+  if (const auto why = robot_id_problem(robot)) throw HttpError(400, "bad_request", *why);
   if (request.body.empty()) {
     throw HttpError(400, "bad_request", "the body must be the scan as a PLY or PCD file");
   }
@@ -89,15 +88,18 @@ Response Api::post_scan(const Request& request) {
   } catch (const ScanFileError& e) {
     throw HttpError(400, "bad_scan", e.what());
   }
-  if (cloud.empty()) throw HttpError(400, "bad_scan", "the uploaded scan holds no valid points");
   const auto stamp = std::chrono::duration_cast<std::chrono::nanoseconds>(
                          std::chrono::system_clock::now().time_since_epoch())
                          .count();
   try {
-    const StoredScan s = app_.intake.submit(robot, estimated, stamp, std::move(cloud));
-    return Response::json(201, scan_json(s, std::nullopt));
+    const SubmittedScan s = app_.intake.submit(robot, estimated, stamp, std::move(cloud));
+    json answer = scan_json(s.scan, std::nullopt);
+    answer["dropped"] = dropped_json(s.dropped);
+    return Response::json(201, answer);
+  } catch (const InvalidScanError& e) {
+    throw HttpError(400, "bad_request", e.what());
   } catch (const UnusableScanError& e) {
-    throw HttpError(400, "bad_scan", e.what());
+    throw HttpError(422, "too_few_points", e.what());
   } catch (const SessionStoreError& e) {
     throw HttpError(503, "storage_failed",
                     std::string("the scan could not be stored: ") + e.what());
@@ -108,7 +110,9 @@ Response Api::list_scans() const {
   json list = json::array();
   for (const StoredScan& s : app_.map.scans())
     list.push_back(scan_json(s, app_.map.areas_after(s.id)));
-  return Response::json(200, {{"scans", list}, {"pending", app_.intake.pending()}});
+  return Response::json(200, {{"scans", list},
+                              {"pending", app_.intake.pending()},
+                              {"not_in_map", not_in_map_json(app_.intake.not_in_map())}});
 }
 
 Response Api::get_scan(const std::string& id) const {
@@ -121,7 +125,10 @@ Response Api::get_scan(const std::string& id) const {
 
 Response Api::request_scan(const Request& request) {
   std::string robot;
-  if (const auto it = request.query.find("robot"); it != request.query.end()) robot = it->second;
+  if (const auto it = request.query.find("robot"); it != request.query.end()) {
+    robot = it->second;
+    if (const auto why = robot_id_problem(robot)) throw HttpError(400, "bad_request", *why);
+  }
   try {
     const std::uint32_t id = app_.dds.request_scan(robot);
     return Response::json(202, {{"command_id", id}, {"robot", robot.empty() ? "*" : robot}});

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sqlite3.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <ctime>
+#include <fstream>
 #include <set>
 
 #include "common/iso_time.hpp"
@@ -117,13 +119,62 @@ StoredScan scan_from_row(const Statement& s) {
 
 }  // namespace
 
-SessionStore::SessionStore(std::filesystem::path dir) : dir_(std::move(dir)) {
+namespace {
+
+std::filesystem::path created(std::filesystem::path dir) {
   std::error_code ec;
-  std::filesystem::create_directories(dir_ / "scans", ec);
+  std::filesystem::create_directories(dir / "scans", ec);
   if (ec)
-    throw SessionStoreError("cannot create the session directory " + dir_.string() + ": " +
+    throw SessionStoreError("cannot create the session directory " + dir.string() + ": " +
                             ec.message());
+  return dir;
+}
+
+// The scan files under scans/ (not the set-aside ones below it, not unfinished writes).
+std::vector<std::filesystem::path> scan_files(const std::filesystem::path& dir) {
+  std::vector<std::filesystem::path> out;
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "scans")) {
+    if (entry.is_regular_file() && entry.path().extension() == ".ply") out.push_back(entry.path());
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+SessionStore::DirectoryLock::DirectoryLock(const std::filesystem::path& dir) {
+  const std::filesystem::path path = dir / "session.lock";
+  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0)
+    throw SessionStoreError("cannot open " + path.string() + ": " + std::strerror(errno));
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    std::string holder;
+    std::getline(std::ifstream(path), holder);
+    ::close(fd_);
+    fd_ = -1;
+    if (err == EWOULDBLOCK) {
+      throw SessionStoreError("the session " + dir.string() + " is open in another process" +
+                              (holder.empty() ? std::string() : " (pid " + holder + ")") +
+                              "; two servers on one session would write over each other's "
+                              "scans: stop that one or give this one another --session");
+    }
+    throw SessionStoreError("cannot lock " + path.string() + ": " + std::strerror(err));
+  }
+  // Who holds it, for the message above; the lock, not the text, is what counts.
+  const std::string pid = std::to_string(::getpid()) + "\n";
+  if (::ftruncate(fd_, 0) == 0) {
+    [[maybe_unused]] const ssize_t n = ::pwrite(fd_, pid.data(), pid.size(), 0);
+  }
+}
+
+SessionStore::DirectoryLock::~DirectoryLock() {
+  if (fd_ >= 0) ::close(fd_);  // closing releases the flock
+}
+
+SessionStore::SessionStore(std::filesystem::path dir) : dir_(created(std::move(dir))), lock_(dir_) {
   const std::string db_path = (dir_ / "session.sqlite").string();
+  const bool had_database = std::filesystem::exists(db_path);
   if (sqlite3_open_v2(db_path.c_str(), &db_,
                       SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
                       nullptr) != SQLITE_OK) {
@@ -155,7 +206,19 @@ SessionStore::SessionStore(std::filesystem::path dir) : dir_(std::move(dir)) {
       "x REAL NOT NULL, y REAL NOT NULL, z REAL NOT NULL, text TEXT NOT NULL, "
       "author TEXT NOT NULL, created_ns INTEGER NOT NULL, created_at TEXT NOT NULL, "
       "deleted_at TEXT, deleted_by TEXT)");
-  remove_orphans();
+  if (!had_database) {
+    if (const auto files = scan_files(dir_); !files.empty()) {
+      sqlite3_close(db_);
+      db_ = nullptr;
+      for (const char* suffix : {"", "-wal", "-shm"}) std::filesystem::remove(db_path + suffix);
+      throw SessionStoreError(
+          "the session " + dir_.string() + " holds " + std::to_string(files.size()) +
+          " scan files (" + files.front().filename().string() +
+          " ...) but no session.sqlite: opening it would start an empty session over them. "
+          "Restore session.sqlite from a backup, or move the scans folder away to start anew");
+    }
+  }
+  tidy_scan_files();
 }
 
 SessionStore::~SessionStore() {
@@ -171,13 +234,32 @@ void SessionStore::exec(const char* sql) const {
   }
 }
 
-void SessionStore::remove_orphans() const {
+void SessionStore::tidy_scan_files() const {
   std::set<std::string> known;
   Statement s(db_, "SELECT file FROM scans");
   while (s.step()) known.insert(s.text(0));
   for (const auto& entry : std::filesystem::directory_iterator(dir_ / "scans")) {
-    const std::string rel = "scans/" + entry.path().filename().string();
-    if (!known.count(rel)) std::filesystem::remove(entry.path());
+    if (!entry.is_regular_file()) continue;
+    const std::filesystem::path& path = entry.path();
+    // A .part is a write that never finished, never acknowledged.
+    if (path.extension() == ".part") {
+      std::filesystem::remove(path);
+      continue;
+    }
+    if (known.count("scans/" + path.filename().string())) continue;
+    // Whole, but its row never committed (a crash between the two), or a file someone put
+    // here: kept for whoever wants it, out of the way of the ids to come.
+    const std::filesystem::path aside = dir_ / "scans" / "unindexed";
+    std::error_code ec;
+    std::filesystem::create_directories(aside, ec);
+    std::filesystem::path to = aside / path.filename();
+    for (int n = 1; std::filesystem::exists(to); ++n) {
+      to = aside / (path.filename().string() + "." + std::to_string(n));
+    }
+    std::filesystem::rename(path, to, ec);
+    if (ec) {
+      throw SessionStoreError("cannot move " + path.string() + " out of the way: " + ec.message());
+    }
   }
 }
 

@@ -73,8 +73,11 @@ inline constexpr std::size_t kMaxAnnotationAuthorBytes = 100;
 // A session on disk (DESIGN.md "Session directory"): session.sqlite in WAL mode plus one binary
 // PLY per scan under scans/. A scan is acknowledged only once both are durable: the PLY is
 // written to a temporary name, synced and renamed before its row commits, so a process killed
-// at any moment leaves either the whole scan or none of it (an orphaned PLY without its row is
-// ignored and removed on the next open). Safe to use from several threads.
+// at any moment leaves either the whole scan or none of it (a PLY without its row is
+// set aside under scans/unindexed/ on the next open, never deleted; an unfinished .part file is
+// removed). Opening refuses (SessionStoreError) a session another process has open, and a
+// folder whose scan files have no database beside them (opening it would start an empty
+// session over them). Safe to use from several threads.
 class SessionStore {
  public:
   // Opens or creates the session in `dir`; throws SessionStoreError naming the path.
@@ -115,9 +118,24 @@ class SessionStore {
 
  private:
   void exec(const char* sql) const;
-  void remove_orphans() const;
+  // Removes unfinished writes and sets aside PLYs without a row (see the class comment).
+  void tidy_scan_files() const;
+
+  // Held open, under an exclusive flock, for the store's life: a second server on the same
+  // session is refused instead of writing scans over the first one's (issue 16).
+  class DirectoryLock {
+   public:
+    explicit DirectoryLock(const std::filesystem::path& dir);
+    ~DirectoryLock();
+    DirectoryLock(const DirectoryLock&) = delete;
+    DirectoryLock& operator=(const DirectoryLock&) = delete;
+
+   private:
+    int fd_ = -1;
+  };
 
   std::filesystem::path dir_;
+  DirectoryLock lock_;
   sqlite3* db_ = nullptr;
   // One connection, so one writer at a time: a transaction spans several calls.
   mutable std::mutex mutex_;

@@ -49,9 +49,9 @@ test('bad uploads are refused with the right status and nothing is stored', asyn
   const mountOnly = 'ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n' +
     'property float z\nend_header\n0.1 0 1\n0 0.2 0.9\n';
   const mount = await stack.api('POST', '/api/v1/scans?x=0&y=0&z=0&yaw_deg=0', { body: mountOnly });
-  assert.equal(mount.status, 400);
+  assert.equal(mount.status, 422);
   const mountError = (await mount.json()).error;
-  assert.equal(mountError.code, 'bad_scan');
+  assert.equal(mountError.code, 'too_few_points');
   assert.match(mountError.message, /2 on the scanner's mount/);
   const viewer = await stack.api('POST', '/api/v1/scans?x=0&y=0&z=0&yaw_deg=0', { auth: stack.viewerToken, body: readFileSync(files[0]) });
   assert.equal(viewer.status, 403);

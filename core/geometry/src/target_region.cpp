@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
+#include <string>
 
 namespace scanplan {
 
@@ -12,12 +14,24 @@ TargetRegion TargetRegion::rectangle(const Eigen::Vector2d& min, const Eigen::Ve
 
 TargetRegion TargetRegion::polygon(std::vector<Eigen::Vector2d> corners) {
   if (corners.size() < 3) throw std::invalid_argument("a target region needs at least 3 corners");
+  if (corners.size() > kMaxCorners) {
+    throw std::invalid_argument("a target region has at most " + std::to_string(kMaxCorners) +
+                                " corners, got " + std::to_string(corners.size()));
+  }
   TargetRegion r;
   r.min_ = r.max_ = corners.front();
   for (const auto& c : corners) {
     if (!c.allFinite()) throw std::invalid_argument("a target region corner is not finite");
     r.min_ = r.min_.cwiseMin(c);
     r.max_ = r.max_.cwiseMax(c);
+  }
+  const Eigen::Vector2d size = r.max_ - r.min_;
+  if (size.maxCoeff() > kMaxSideM) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf,
+                  "a target region spans at most %.0f m a side, this one %.0f m by %.0f m",
+                  kMaxSideM, size.x(), size.y());
+    throw std::invalid_argument(buf);
   }
   r.corners_ = std::move(corners);
   if (r.area_m2() <= 0) throw std::invalid_argument("the target region encloses no area");

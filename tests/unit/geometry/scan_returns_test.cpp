@@ -51,6 +51,22 @@ TEST(ScanReturns, DropsNaNsTheMountAndASaturationShellAndCountsEach) {
   }
 }
 
+TEST(ScanReturns, PointsBeyondAnyScannersReachAreDroppedWithoutHidingTheShell) {
+  // One point at 1e30 (a broken driver, a hostile client) would spread the map over the world;
+  // nor may it stand in for the farthest range the saturation shell is found at.
+  PointCloud c = scene(20000, 3);
+  add_shell(c, 400, 32.76f);
+  c.push_back({1e30f, 0, 0}, {0, 0, 0});
+  c.push_back({0, -3e38f, 1}, {0, 0, 0});
+  c.push_back({0, 0, 1500}, {0, 0, 0});
+  const DroppedReturns d = drop_bad_returns(c);
+  EXPECT_EQ(d.out_of_range, 3u);
+  EXPECT_EQ(d.saturated, 400u);
+  EXPECT_EQ(d.non_finite, 0u);
+  EXPECT_EQ(d.total(), 403u);
+  EXPECT_EQ(c.size(), 20000u);
+}
+
 TEST(ScanReturns, ARealSceneKeepsItsFarthestPoints) {
   // Ranges that merely end somewhere: the few points near the farthest are the scene.
   PointCloud c = scene(20000, 2);

@@ -112,20 +112,65 @@ TEST_F(SessionDir, EventsReadBackNewestLimitOldestFirst) {
   EXPECT_EQ(last[1].kind, "approve");
 }
 
-TEST_F(SessionDir, PartialWritesFromACrashAreDiscardedOnOpen) {
+TEST_F(SessionDir, PartialWritesFromACrashAreDiscardedAndWholeFilesSetAside) {
   {
     SessionStore first(dir_);
     first.add_scan("robot1", {}, {}, 1, cloud_of(3, 0));
   }
   // What a process killed mid-scan leaves: a half-written temporary and a PLY whose row never
-  // committed.
+  // committed (twice over: an earlier crash's file is already set aside under the same name).
   std::ofstream(dir_ / "scans" / "scan_000002.ply.part") << "ply\nformat binary";
-  std::ofstream(dir_ / "scans" / "scan_000002.ply") << "ply\n";
+  std::ofstream(dir_ / "scans" / "scan_000002.ply") << "ply\nsecond\n";
+  std::filesystem::create_directories(dir_ / "scans" / "unindexed");
+  std::ofstream(dir_ / "scans" / "unindexed" / "scan_000002.ply") << "ply\nfirst\n";
   SessionStore s(dir_);
   EXPECT_EQ(s.scans().size(), 1u);
   EXPECT_FALSE(std::filesystem::exists(dir_ / "scans" / "scan_000002.ply"));
   EXPECT_FALSE(std::filesystem::exists(dir_ / "scans" / "scan_000002.ply.part"));
+  // Never deleted: a whole file may be someone's only copy.
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "scans" / "unindexed" / "scan_000002.ply"));
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "scans" / "unindexed" / "scan_000002.ply.1"));
   EXPECT_EQ(s.add_scan("robot1", {}, {}, 2, cloud_of(2, 0)).id, 2);
+}
+
+TEST_F(SessionDir, ScanFilesWithoutADatabaseAreRefusedAndLeftAlone) {
+  {
+    SessionStore first(dir_);
+    first.add_scan("robot1", {}, {}, 1, cloud_of(3, 0));
+    first.add_scan("robot1", {}, {}, 2, cloud_of(3, 0));
+  }
+  for (const char* f : {"session.sqlite", "session.sqlite-wal", "session.sqlite-shm"}) {
+    std::filesystem::remove(dir_ / f);
+  }
+  try {
+    SessionStore s(dir_);
+    FAIL() << "opening scan files without their database would start an empty session";
+  } catch (const SessionStoreError& e) {
+    EXPECT_NE(std::string(e.what()).find("2 scan files"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("session.sqlite"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "scans" / "scan_000001.ply"));
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "scans" / "scan_000002.ply"));
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "session.sqlite"));
+}
+
+TEST_F(SessionDir, ASecondStoreOnTheSameSessionIsRefusedUntilTheFirstCloses) {
+  {
+    SessionStore first(dir_);
+    first.add_scan("robot1", {}, {}, 1, cloud_of(3, 0));
+    try {
+      SessionStore second(dir_);
+      FAIL() << "two stores on one session would write over each other's scans";
+    } catch (const SessionStoreError& e) {
+      EXPECT_NE(std::string(e.what()).find("open in another process (pid " +
+                                           std::to_string(::getpid()) + ")"),
+                std::string::npos)
+          << e.what();
+    }
+    EXPECT_EQ(first.add_scan("robot1", {}, {}, 2, cloud_of(3, 0)).id, 2);
+  }
+  SessionStore again(dir_);
+  EXPECT_EQ(again.scans().size(), 2u);
 }
 
 TEST_F(SessionDir, UnusableDirectoryIsReportedWithItsPath) {

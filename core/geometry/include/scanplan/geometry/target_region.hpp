@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <vector>
 
 namespace scanplan {
@@ -12,8 +13,16 @@ bool polygon_contains(const std::vector<Eigen::Vector2d>& corners, double x, dou
 // "target region"). A rectangle is the common case.
 class TargetRegion {
  public:
+  // The segmentation, the layers and the planner keep a grid over the region's bounding box
+  // (0.5 m cells, 2 px a cell on the page): a region wider than this is a typo, and one of 1e9 m
+  // would ask for more memory than the machine has (issue 16). A kilometre a side, four times
+  // the paper's campus, is a large rescue site: 4 M cells, a 64 MB layer image.
+  static constexpr double kMaxSideM = 1000.0;
+  static constexpr std::size_t kMaxCorners = 1000;
+
   static TargetRegion rectangle(const Eigen::Vector2d& min, const Eigen::Vector2d& max);
-  // Throws std::invalid_argument for fewer than three corners or a non-finite one.
+  // Throws std::invalid_argument, saying what is wrong, for fewer than three corners or more than
+  // kMaxCorners, a non-finite corner, a bounding box wider than kMaxSideM or no area.
   static TargetRegion polygon(std::vector<Eigen::Vector2d> corners);
 
   bool contains(double x, double y) const;

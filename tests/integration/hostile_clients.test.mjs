@@ -1,0 +1,182 @@
+// Issue 16: what a broken client or a careless script sends must not stop the operators, and
+// nothing the server acknowledged may be lost. One real server on an ephemeral port; each case
+// checks the answer and that the map, the plan and the session are as they should be after it.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawn } from 'node:child_process';
+import { existsSync, mkdtempSync, readdirSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { startStack, requireEnv } from '../support/stack.mjs';
+
+// A 20 m room seen from its middle: walls 3 m high and the floor, in the robot frame (the
+// ground at z = 0), with any extra vertices appended.
+function roomPly(extra = [], count = 4000) {
+  const lines = [];
+  let seed = 7;
+  const rand = () => ((seed = (seed * 1103515245 + 12345) % 2147483648) / 2147483648);
+  for (let i = 0; i < count; i++) {
+    const u = -10 + 20 * rand();
+    if (i % 2 === 0) {
+      const side = [[u, -10], [u, 10], [-10, u], [10, u]][i % 8 / 2];
+      lines.push(`${side[0]} ${side[1]} ${3 * rand()}`);
+    } else {
+      lines.push(`${u} ${-10 + 20 * rand()} 0`);
+    }
+  }
+  for (const p of extra) lines.push(p.join(' '));
+  return 'ply\nformat ascii 1.0\nelement vertex ' + lines.length +
+    '\nproperty float x\nproperty float y\nproperty float z\nend_header\n' + lines.join('\n') + '\n';
+}
+
+let dir, stack;
+const session = async () => (await stack.api('GET', '/api/v1/session')).json();
+const errorOf = async (r) => (await r.json()).error;
+
+before(async () => {
+  dir = mkdtempSync(join(tmpdir(), 'scanplan-hostile-'));
+  stack = await startStack({ bridge: false, dir: join(dir, 'run') });
+});
+after(async () => {
+  if (stack) await stack.stop({ keepDir: true });
+  rmSync(dir, { recursive: true, force: true });
+});
+
+test('absurd but finite poses are refused by name and nothing is stored', async () => {
+  const cases = [
+    ['x=1e7&y=0&z=0&yaw_deg=0', /pose's x is 1e\+07 m/],
+    ['x=1e308&y=0&z=0&yaw_deg=0', /pose's x is 1e\+308/],
+    ['x=0&y=-2e5&z=0&yaw_deg=0', /pose's y/],
+    ['x=0&y=0&z=0&yaw_deg=10000', /pose's yaw is 10000°/],
+    ['x=0x1p3&y=0&z=0&yaw_deg=0', /'x' must be a finite decimal number/],
+    ['x=inf&y=0&z=0&yaw_deg=0', /'x' must be a finite decimal number/],
+    ['x=1e400&y=0&z=0&yaw_deg=0', /'x' must be a finite decimal number/],
+    ['x=1&y=0&z=0&yaw_deg=0&robot=a%0Ab', /'robot' must be 1 to 64 characters/],
+  ];
+  for (const [query, message] of cases) {
+    const r = await stack.api('POST', `/api/v1/scans?${query}`, { body: roomPly() });
+    assert.equal(r.status, 400, query);
+    assert.match((await errorOf(r)).message, message, query);
+  }
+  assert.deepEqual((await (await stack.api('GET', '/api/v1/scans')).json()).scans, []);
+});
+
+test('points beyond any scanner\'s reach are dropped and counted, and the scan joins the map', async () => {
+  const r = await stack.api('POST', '/api/v1/scans?x=0&y=0&z=0&yaw_deg=0',
+    { body: roomPly([[1e30, 0, 0], [0, -1e30, 1], [0, 0, 5000]]) });
+  assert.equal(r.status, 201);
+  const scan = await r.json();
+  assert.deepEqual(scan.dropped, { non_finite: 0, out_of_range: 3, mount: 0, saturated: 0 });
+  assert.equal(scan.points, 4000);
+  const s = await stack.waitFor('the scan in the map', async () => {
+    const j = await session();
+    return j.scans === 1 && j.areas.movable_m2 > 0 ? j : undefined;
+  });
+  for (const v of [...s.bounds.min, ...s.bounds.max]) assert.ok(Math.abs(v) < 20, `bounds ${JSON.stringify(s.bounds)}`);
+  const plan = await (await stack.api('GET', '/api/v1/candidates')).json();
+  assert.ok(plan.candidates.length > 0, 'the planner still has somewhere to go');
+});
+
+test('a scan with too few measurements is refused with 422', async () => {
+  const tiny = await stack.api('POST', '/api/v1/scans?x=1&y=0&z=0&yaw_deg=0', { body: roomPly([], 50) });
+  assert.equal(tiny.status, 422);
+  const e = await errorOf(tiny);
+  assert.equal(e.code, 'too_few_points');
+  assert.match(e.message, /50 of the scan's points are measurements, at least 100/);
+  const far = await stack.api('POST', '/api/v1/scans?x=1&y=0&z=0&yaw_deg=0',
+    { body: roomPly(Array.from({ length: 200 }, (_, i) => [1e20, i, 0]), 0) });
+  assert.equal(far.status, 422);
+  assert.match((await errorOf(far)).message, /200 beyond 1000 m/);
+  assert.equal((await session()).scans, 1);
+});
+
+test('text fields are checked and capped', async () => {
+  const reject = (body) => stack.api('POST', '/api/v1/candidates/1/reject', { body: JSON.stringify(body) });
+  let r = await reject({ reason: 'x'.repeat(5_000_000) });
+  assert.equal(r.status, 400);
+  assert.match((await errorOf(r)).message, /'reason' is too long: 5000000 bytes/);
+  r = await reject({ reason: 'stairs\u001b[2J' });
+  assert.equal(r.status, 400);
+  r = await reject({ by: 'Ann\nEve' });
+  assert.equal(r.status, 400);
+  assert.match((await errorOf(r)).message, /'by' must be one line/);
+  r = await stack.api('POST', '/api/v1/goals', { body: JSON.stringify({ x: 1, y: 1, robot: 'r\n1' }) });
+  assert.equal(r.status, 400);
+  r = await stack.api('GET', '/api/v1/candidates?robot=' + encodeURIComponent('a b'));
+  assert.equal(r.status, 400);
+  r = await stack.api('POST', '/api/v1/annotations',
+    { body: JSON.stringify({ kind: 'note', x: 1, y: 1, z: 0, text: 'bell\u0007' }) });
+  assert.equal(r.status, 400);
+  r = await stack.api('POST', '/api/v1/annotations',
+    { body: JSON.stringify({ kind: 'note', x: 1, y: 1, z: 0, text: 'two adults,\nstairs blocked' }) });
+  assert.equal(r.status, 201);
+});
+
+test('a target region of 1e9 m is refused and changes nothing; later changes and scans work', async () => {
+  const put = (body) => stack.api('PUT', '/api/v1/params', { body: JSON.stringify(body) });
+  const before = await (await stack.api('GET', '/api/v1/params')).json();
+  for (const target of [[[0, 0], [1e9, 0], [1e9, 1e9]], [[0, 0], [5000, 0], [5000, 10]],
+    [[0, 0], [1, 0]], [[0, 0], ['a', 0], [1, 1]]]) {
+    const r = await put({ alpha: 0.2, target });
+    assert.equal(r.status, 400, JSON.stringify(target));
+  }
+  assert.deepEqual(await (await stack.api('GET', '/api/v1/params')).json(), before, 'a refused PUT changes nothing');
+  const ok = await put({ target: [[-40, -40], [40, -40], [40, 40], [-40, 40]] });
+  assert.equal(ok.status, 200);
+  const r = await stack.api('POST', '/api/v1/scans?x=5&y=0&z=0&yaw_deg=0', { body: roomPly() });
+  assert.equal(r.status, 201);
+  await stack.waitFor('the second scan in the map', async () => ((await session()).scans === 2 ? true : undefined));
+});
+
+// Runs the server binary on `sessionDir` and returns its exit code and output.
+function runServer(sessionDir) {
+  return new Promise((resolve) => {
+    const p = spawn(requireEnv('SCANPLAN_SERVER'),
+      ['--session', sessionDir, '--listen', '127.0.0.1:0', '--domain', requireEnv('SCANPLAN_TEST_DOMAIN'),
+        '--web', requireEnv('SCANPLAN_WEB_DIR')],
+      { env: { ...process.env, SCANPLAN_OPERATOR_TOKEN: 'x'.repeat(32) }, stdio: ['ignore', 'pipe', 'pipe'] });
+    let out = '';
+    p.stdout.on('data', (c) => { out += c; });
+    p.stderr.on('data', (c) => { out += c; });
+    const timer = setTimeout(() => p.kill('SIGKILL'), 15000);
+    p.on('exit', (code) => { clearTimeout(timer); resolve({ code, out }); });
+  });
+}
+
+test('a second server on the same session is refused', async () => {
+  const second = await runServer(join(stack.dir, 'session'));
+  assert.notEqual(second.code, 0);
+  assert.match(second.out, /is open in another process \(pid \d+\)/);
+  assert.equal((await session()).scans, 2, 'the first server is untouched');
+});
+
+test('after a restart a lost scan file is reported, not silently missing', async () => {
+  await stack.stop({ keepDir: true });
+  const scans = join(stack.dir, 'session', 'scans');
+  rmSync(join(scans, 'scan_000001.ply'));
+  stack = await startStack({ bridge: false, dir: stack.dir });
+  const s = await stack.waitFor('the session rebuilt', async () => {
+    const j = await session();
+    return j.rebuilding === null ? j : undefined;
+  });
+  assert.equal(s.scans, 1);
+  assert.equal(s.scans_not_in_map.length, 1);
+  assert.equal(s.scans_not_in_map[0].id, 1);
+  assert.match(s.scans_not_in_map[0].reason, /scan_000001\.ply/);
+  const list = await (await stack.api('GET', '/api/v1/scans')).json();
+  assert.deepEqual(list.not_in_map.map((x) => x.id), [1]);
+});
+
+test('scan files without their database are refused, not emptied', async () => {
+  await stack.stop({ keepDir: true });
+  const sessionDir = join(stack.dir, 'session');
+  for (const f of ['session.sqlite', 'session.sqlite-wal', 'session.sqlite-shm']) {
+    rmSync(join(sessionDir, f), { force: true });
+  }
+  const r = await runServer(sessionDir);
+  assert.notEqual(r.code, 0);
+  assert.match(r.out, /holds 1 scan files .* but no session\.sqlite/);
+  assert.deepEqual(readdirSync(join(sessionDir, 'scans')).filter((f) => f.endsWith('.ply')), ['scan_000002.ply']);
+  assert.ok(!existsSync(join(sessionDir, 'session.sqlite')));
+  stack = undefined;
+});
