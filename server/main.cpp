@@ -84,6 +84,8 @@ http::ServerConfig server_config(const Options& o) {
   config.reuse_port = o.http_threads > 1;
   config.limits.max_connections =
       std::max<std::size_t>(1, config.limits.max_connections / o.http_threads);
+  config.limits.max_connections_per_address =
+      std::max<std::size_t>(1, config.limits.max_connections_per_address / o.http_threads);
   return config;
 }
 
@@ -136,7 +138,7 @@ void serve(http::ServerConfig config, int count, const http::Router& router,
 // The whole server: storage, the application, DDS and HTTP, wired and run until stopped.
 void run(const Options& o) {
   // Flags first: a mistyped --listen must not open (or create) a session.
-  const http::ServerConfig config = server_config(o);
+  http::ServerConfig config = server_config(o);
   std::string operator_token = env_or_empty("SCANPLAN_OPERATOR_TOKEN");
   const bool generated = operator_token.empty();
   if (generated) operator_token = srv::Auth::random_token();
@@ -170,6 +172,7 @@ void run(const Options& o) {
   srv::Api api({map, plans, robots, intake, dds, mission, annotations, hub}, auth, o.session_dir);
   http::Router router([](std::string_view msg) { spdlog::error("{}", msg); });
   api.install(router);
+  config.admit = [&api](const http::Request& head) { return api.admit(head); };
   const http::StaticFiles files(o.web_dir);
   router.set_fallback(
       [&files](const http::Request& r, const http::Router::Params&) { return files.serve(r); });

@@ -66,9 +66,20 @@ std::string peer_text(const sockaddr_storage& addr) {
   if (addr.ss_family == AF_INET6) {
     const auto& in6 = reinterpret_cast<const sockaddr_in6&>(addr);
     inet_ntop(AF_INET6, &in6.sin6_addr, text, sizeof(text));
-    return "[" + std::string(text) + "]:" + std::to_string(ntohs(in6.sin6_port));
+    // Appended, not "[" + ...: GCC 12 warns of a false overlap in the operator+ chain.
+    std::string out = "[";
+    out += text;
+    out += "]:";
+    out += std::to_string(ntohs(in6.sin6_port));
+    return out;
   }
   return "unknown";
+}
+
+// The client's address without its port: what max_connections_per_address counts.
+std::string address_text(const std::string& peer) {
+  const std::size_t colon = peer.rfind(':');
+  return colon == std::string::npos ? peer : peer.substr(0, colon);
 }
 
 // Linux reports network errors already pending on a new connection through accept(2); they
@@ -293,8 +304,14 @@ void HttpServer::accept_all(Clock::time_point now) {
     ::setsockopt(client.get(), IPPROTO_TCP, TCP_NODELAY, &one, sizeof(one));
 
     const std::uint64_t id = next_id_++;
-    auto conn =
-        std::make_unique<Connection>(id, std::move(client), peer_text(addr), config_.limits, now);
+    std::string peer = peer_text(addr);
+    std::string address = address_text(peer);
+    const std::size_t from_there = static_cast<std::size_t>(
+        std::count_if(connections_.begin(), connections_.end(),
+                      [&](const auto& c) { return c.second->fd && c.second->address == address; }));
+    const bool over_address_limit = from_there >= config_.limits.max_connections_per_address;
+    auto conn = std::make_unique<Connection>(id, std::move(client), std::move(peer),
+                                             std::move(address), config_.limits, now);
     epoll_event ev{};
     ev.events = EPOLLIN | EPOLLRDHUP;
     ev.data.u64 = id;
@@ -308,6 +325,11 @@ void HttpServer::accept_all(Clock::time_point now) {
       queue_error(
           c, 503,
           "the server already has " + std::to_string(limit) + " connections open; retry later");
+    } else if (over_address_limit) {
+      queue_error(c, 503,
+                  "this address already holds " +
+                      std::to_string(config_.limits.max_connections_per_address) +
+                      " connections; close some or retry later");
     }
     settle(c, now);
   }
@@ -339,7 +361,8 @@ void HttpServer::on_event(Connection& conn, std::uint32_t events, Clock::time_po
 
 bool HttpServer::can_read(const Connection& conn) const {
   return !conn.closing && !conn.peer_eof && !conn.upgrade &&
-         conn.queued_responses < config_.limits.max_pipelined;
+         conn.queued_responses < config_.limits.max_pipelined &&
+         conn.out.pending_bytes() < config_.limits.max_queued_bytes;
 }
 
 void HttpServer::read_input(Connection& conn, Clock::time_point now) {
@@ -351,6 +374,7 @@ void HttpServer::read_input(Connection& conn, Clock::time_point now) {
         conn.in_parsed = 0;
       }
       conn.in.append(read_buffer_.data(), static_cast<std::size_t>(n));
+      conn.received += static_cast<std::uint64_t>(n);
       conn.last_activity = now;
       process(conn, now);
       if (static_cast<std::size_t>(n) < read_buffer_.size()) return;
@@ -386,9 +410,15 @@ void HttpServer::discard_input(Connection& conn) {
 
 void HttpServer::process(Connection& conn, Clock::time_point now) {
   while (!conn.closing && !conn.upgrade && conn.queued_responses < config_.limits.max_pipelined &&
-         !conn.unparsed().empty()) {
+         conn.out.pending_bytes() < config_.limits.max_queued_bytes && !conn.unparsed().empty()) {
     conn.in_parsed += conn.parser.feed(conn.unparsed());
-    switch (conn.parser.state()) {
+    const RequestParser::State state = conn.parser.state();
+    if (state != RequestParser::State::kError &&
+        (conn.parser.headers_complete() || state == RequestParser::State::kComplete) &&
+        !admit(conn)) {
+      break;
+    }
+    switch (state) {
       case RequestParser::State::kError:
         queue_error(conn, conn.parser.error_status(), conn.parser.error_message());
         break;
@@ -407,11 +437,34 @@ void HttpServer::process(Connection& conn, Clock::time_point now) {
     conn.head_timer = true;
     conn.head_started = now;
   }
+  if (conn.parser.headers_complete() && !conn.body_timer) {
+    conn.body_timer = true;
+    conn.body_started = now;
+    conn.received_at_body = conn.received - conn.unparsed().size();
+  }
   // Sent only once the headers passed every check, so a client told 413 never sends the body.
   if (conn.parser.expects_continue() && !conn.continue_sent) {
-    conn.out += kContinue;
+    conn.out.append(std::string(kContinue));
     conn.continue_sent = true;
   }
+}
+
+bool HttpServer::admit(Connection& conn) {
+  if (conn.admitted) return true;
+  conn.admitted = true;
+  if (!config_.admit) return true;
+  std::optional<Response> refusal;
+  try {
+    refusal = config_.admit(conn.parser.head());
+  } catch (const std::exception& e) {
+    log(std::string("http: admission check failed: ") + e.what());
+    refusal = Response::error(500, "internal", "internal error while checking the request");
+  }
+  if (!refusal) return true;
+  queue(conn, *refusal, /*keep_alive=*/false, conn.parser.head().method == "HEAD");
+  ++conn.queued_responses;
+  conn.closing = true;
+  return false;
 }
 
 Response HttpServer::call_handler(const Request& request) {
@@ -434,6 +487,8 @@ Response HttpServer::call_handler(const Request& request) {
 
 void HttpServer::respond(Connection& conn, Request request) {
   conn.head_timer = false;
+  conn.body_timer = false;
+  conn.admitted = false;
   conn.continue_sent = false;
   conn.served_any = true;
 
@@ -451,42 +506,41 @@ void HttpServer::respond(Connection& conn, Request request) {
   if (keep_alive && request.version_minor == 0 && !response.header("Connection")) {
     response.set_header("Connection", "keep-alive");
   }
-  conn.out += serialize(response, keep_alive, request.method == "HEAD");
+  queue(conn, response, keep_alive, request.method == "HEAD");
   ++conn.queued_responses;
   if (!keep_alive) conn.closing = true;
 }
 
+void HttpServer::queue(Connection& conn, const Response& response, bool keep_alive,
+                       bool head_request) {
+  conn.out.append(serialize_head(response, keep_alive));
+  if (!sends_body(response, head_request)) return;
+  if (response.shared_owner) {
+    conn.out.append_shared(response.shared_owner, response.shared_body);
+  } else {
+    conn.out.append(response.body);
+  }
+}
+
 void HttpServer::queue_error(Connection& conn, int status, std::string_view message) {
-  conn.out += serialize(Response::error(status, error_code(status), message), false, false);
+  queue(conn, Response::error(status, error_code(status), message), false, false);
   ++conn.queued_responses;
   conn.closing = true;
 }
 
 bool HttpServer::flush(Connection& conn, Clock::time_point now) {
   while (conn.has_output()) {
-    const ssize_t n = ::send(conn.fd.get(), conn.out.data() + conn.out_sent,
-                             conn.out.size() - conn.out_sent, MSG_NOSIGNAL);
+    const ssize_t n = conn.out.send_some(conn.fd.get());
     if (n > 0) {
-      conn.out_sent += static_cast<std::size_t>(n);
       conn.last_activity = now;
-    } else if (n < 0 && errno == EINTR) {
-      continue;
-    } else if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
-      break;
+    } else if (n == 0) {
+      break;  // the socket's buffer is full
     } else {
       close(conn);  // EPIPE or ECONNRESET: the client is gone
       return false;
     }
   }
-  if (!conn.has_output()) {
-    conn.out.clear();
-    conn.out_sent = 0;
-    conn.queued_responses = 0;
-  } else if (conn.out_sent >= (1u << 20) && conn.out_sent * 2 >= conn.out.size()) {
-    // Drop the sent front of a large buffer, but rarely enough that it stays amortised O(1).
-    conn.out.erase(0, conn.out_sent);
-    conn.out_sent = 0;
-  }
+  if (!conn.has_output()) conn.queued_responses = 0;
   return true;
 }
 
@@ -516,6 +570,14 @@ void HttpServer::settle(Connection& conn, Clock::time_point now) {
   const Limits& limits = config_.limits;
   if (conn.parser.started() && !conn.parser.headers_complete()) {
     conn.deadline = conn.head_started + limits.header_timeout;
+  } else if (conn.parser.headers_complete() && conn.body_timer && !conn.has_output()) {
+    // A stall, or a body that falls behind the minimum rate once the grace period is over.
+    const double got = static_cast<double>(conn.received - conn.received_at_body);
+    const auto behind =
+        conn.body_started + limits.body_grace +
+        std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+            got / static_cast<double>(std::max<std::size_t>(limits.min_body_bytes_per_s, 1))));
+    conn.deadline = std::min(conn.last_activity + limits.body_timeout, behind);
   } else if (conn.parser.headers_complete() || conn.has_output()) {
     conn.deadline = conn.last_activity + limits.body_timeout;
   } else {
@@ -559,12 +621,14 @@ void HttpServer::on_timeout(Connection& conn, Clock::time_point now) {
     close(conn);  // idle keep-alive connection: closing silently is the convention
     return;
   }
-  const std::string message = conn.parser.headers_complete()
-                                  ? "request body stalled for more than " +
-                                        std::to_string(config_.limits.body_timeout.count()) + " ms"
-                                  : "request header not received within " +
-                                        std::to_string(config_.limits.header_timeout.count()) +
-                                        " ms";
+  const std::string message =
+      conn.parser.headers_complete()
+          ? "request body stalled for more than " +
+                std::to_string(config_.limits.body_timeout.count()) +
+                " ms, or arrived slower than " +
+                std::to_string(config_.limits.min_body_bytes_per_s) + " bytes/s"
+          : "request header not received within " +
+                std::to_string(config_.limits.header_timeout.count()) + " ms";
   queue_error(conn, 408, message);
   conn.last_activity = now;
   settle(conn, now);

@@ -6,6 +6,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -30,6 +31,11 @@ struct ServerConfig {
   // kernel spreads new connections over them, so the API uses more than one core. Start one
   // with the wanted port (0 for an ephemeral one), then the others on the port it got.
   bool reuse_port = false;
+  // Called on the loop thread as soon as a request's header section is in, before its body is
+  // read or "100 Continue" is sent: a response refuses the request (it is sent and the
+  // connection closed, the body never read), so that a client without a valid token cannot
+  // make the server receive and buffer hundreds of megabytes (issue 16). Empty: all admitted.
+  std::function<std::optional<Response>(const Request& head)> admit;
 };
 
 // HTTP/1.1 server: one thread runs a level-triggered epoll loop over non-blocking sockets.
@@ -81,6 +87,10 @@ class HttpServer {
   void discard_input(Connection& conn);
   void process(Connection& conn, Clock::time_point now);
   void respond(Connection& conn, Request request);
+  // Queues `response` on the connection (its head, then its body, shared or owned).
+  void queue(Connection& conn, const Response& response, bool keep_alive, bool head_request);
+  // Whether the current request's head passes ServerConfig::admit; if not, queues the refusal.
+  bool admit(Connection& conn);
   Response call_handler(const Request& request);
   void queue_error(Connection& conn, int status, std::string_view message);
   bool flush(Connection& conn, Clock::time_point now);

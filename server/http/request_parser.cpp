@@ -53,6 +53,7 @@ void RequestParser::reset() {
   phase_ = Phase::kRequestLine;
   request_ = Request{};
   line_.clear();
+  authority_.clear();
   head_bytes_ = 0;
   field_count_ = 0;
   remaining_ = 0;
@@ -190,7 +191,7 @@ bool RequestParser::on_request_line(std::string_view line) {
     return fail(400, kShape);
   }
   const std::string_view method = line.substr(0, sp1);
-  const std::string_view target = line.substr(sp1 + 1, sp2 - sp1 - 1);
+  std::string_view target = line.substr(sp1 + 1, sp2 - sp1 - 1);
   const std::string_view version = line.substr(sp2 + 1);
 
   if (!ascii::is_token(method)) return fail(400, "malformed request line: invalid method");
@@ -214,8 +215,31 @@ bool RequestParser::on_request_line(std::string_view line) {
                 "request target contains a character that must be percent-encoded (space, "
                 "control, non-ASCII or '#')");
   }
+  // The absolute-form ("http://host:port/path?query"), which a server must accept (RFC 9112
+  // §3.2.2): its authority replaces the Host field (§3.2.2 and RFC 9110 §7.2), the rest is the
+  // origin-form. Authority-form (CONNECT) and asterisk-form (OPTIONS *) stay refused.
   if (target.front() != '/') {
-    return fail(400, "request target must be a path starting with '/' (origin-form)");
+    const std::size_t scheme_end = target.find("://");
+    const std::string_view scheme =
+        scheme_end == std::string_view::npos ? std::string_view() : target.substr(0, scheme_end);
+    if (!ascii::iequals(scheme, "http") && !ascii::iequals(scheme, "https")) {
+      return fail(400,
+                  "request target must be a path starting with '/' (origin-form) or an http URI "
+                  "(absolute-form)");
+    }
+    const std::string_view rest = target.substr(scheme_end + 3);
+    const std::size_t authority_end = rest.find_first_of("/?");
+    const std::string_view authority = rest.substr(0, authority_end);
+    if (authority.empty() || authority.find('@') != std::string_view::npos) {
+      return fail(400, "an absolute-form request target needs a host and no user information");
+    }
+    authority_ = std::string(authority);
+    origin_form_ =
+        authority_end == std::string_view::npos ? "/" : std::string(rest.substr(authority_end));
+    if (origin_form_.front() == '?') origin_form_.insert(0, "/");
+    target = origin_form_;
+  } else {
+    authority_.clear();
   }
 
   const std::size_t question = target.find('?');
@@ -299,6 +323,12 @@ bool RequestParser::on_headers_done() {
     }
   }
 
+  if (!authority_.empty()) {
+    // The target's authority is the host; a Host field sent along is ignored (replaced).
+    std::erase_if(request_.headers, [](const Header& h) { return ascii::iequals(h.name, "host"); });
+    request_.headers.push_back({"Host", authority_});
+    hosts = 1;
+  }
   if (hosts == 0 && request_.version_minor >= 1) {
     return fail(400, "missing Host header (required in HTTP/1.1)");
   }

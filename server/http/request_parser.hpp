@@ -49,6 +49,9 @@ class RequestParser {
   bool started() const { return started_; }
   // Whether the header section is complete and the body is being received.
   bool headers_complete() const { return headers_complete_; }
+  // The request as parsed so far: once headers_complete(), its method, target, version and
+  // header fields (the body still arriving).
+  const Request& head() const { return request_; }
   // Whether the client waits for "100 Continue" before sending its body.
   bool expects_continue() const { return expect_continue_; }
 
@@ -70,6 +73,8 @@ class RequestParser {
   Phase phase_ = Phase::kRequestLine;
   Request request_;
   std::string line_;             // the current line, accumulated across feed() calls
+  std::string authority_;        // of an absolute-form target, else empty
+  std::string origin_form_;      // an absolute-form target's path and query
   std::size_t head_bytes_ = 0;   // bytes of request line, fields and trailers processed so far
   std::size_t field_count_ = 0;  // header fields plus trailer fields
   std::size_t remaining_ = 0;    // body bytes still expected (Content-Length or current chunk)

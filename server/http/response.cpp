@@ -58,6 +58,29 @@ Response Response::bytes(std::string body, std::string_view content_type) {
   return r;
 }
 
+Response Response::shared(std::shared_ptr<const std::string> body, std::string_view content_type) {
+  Response r;
+  r.shared_body = body ? std::string_view(*body) : std::string_view();
+  r.shared_owner = std::move(body);
+  r.headers.push_back({"Content-Type", std::string(content_type)});
+  return r;
+}
+
+Response Response::shared(std::shared_ptr<const std::vector<std::uint8_t>> body,
+                          std::string_view content_type) {
+  Response r;
+  if (body) {
+    r.shared_body = std::string_view(reinterpret_cast<const char*>(body->data()), body->size());
+  }
+  r.shared_owner = std::move(body);
+  r.headers.push_back({"Content-Type", std::string(content_type)});
+  return r;
+}
+
+std::string_view Response::body_bytes() const {
+  return shared_owner ? shared_body : std::string_view(body);
+}
+
 void Response::set_header(std::string_view name, std::string_view value) {
   std::erase_if(headers, [&](const Header& h) { return ascii::iequals(h.name, name); });
   headers.push_back({std::string(name), std::string(value)});
@@ -70,12 +93,12 @@ std::optional<std::string_view> Response::header(std::string_view name) const {
   return std::nullopt;
 }
 
-std::string serialize(const Response& response, bool keep_alive, bool head_request) {
+std::string serialize_head(const Response& response, bool keep_alive) {
   const int status = (response.status >= 100 && response.status <= 999) ? response.status : 500;
   const bool bodyless = status < 200 || status == 204 || status == 304;
 
   std::string out;
-  out.reserve(256 + (bodyless || head_request ? 0 : response.body.size()));
+  out.reserve(256);
   out += "HTTP/1.1 ";
   out += std::to_string(status);
   out += ' ';
@@ -100,12 +123,22 @@ std::string serialize(const Response& response, bool keep_alive, bool head_reque
   if (!bodyless) {
     // A HEAD response announces the length the GET body would have (RFC 9110 §9.3.2).
     out += "Content-Length: ";
-    out += std::to_string(response.body.size());
+    out += std::to_string(response.body_bytes().size());
     out += "\r\n";
   }
   if (!keep_alive) out += "Connection: close\r\n";
   out += "\r\n";
-  if (!bodyless && !head_request) out += response.body;
+  return out;
+}
+
+bool sends_body(const Response& response, bool head_request) {
+  const int status = (response.status >= 100 && response.status <= 999) ? response.status : 500;
+  return !(status < 200 || status == 204 || status == 304) && !head_request;
+}
+
+std::string serialize(const Response& response, bool keep_alive, bool head_request) {
+  std::string out = serialize_head(response, keep_alive);
+  if (sends_body(response, head_request)) out += response.body_bytes();
   return out;
 }
 

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <cstdint>
 #include <functional>
+#include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <string>
@@ -20,6 +22,10 @@ struct Response {
   int status = 200;
   std::vector<Header> headers;  // framing fields (Content-Length, Transfer-Encoding) are ignored
   std::string body;
+  // A body shared with whoever made it (the map's encoding, a layer image), sent without a copy
+  // (OutputQueue); used instead of `body` when set. `shared_body` lives as long as the owner.
+  std::shared_ptr<const void> shared_owner;
+  std::string_view shared_body;
   // Honoured only with status 101: the server writes the response, then hands the socket over.
   UpgradeHandler on_upgrade;
 
@@ -29,6 +35,11 @@ struct Response {
   // The REST error shape: {"error":{"code":code,"message":message}}.
   static Response error(int status, std::string_view code, std::string_view message);
   static Response bytes(std::string body, std::string_view content_type);
+  static Response shared(std::shared_ptr<const std::string> body, std::string_view content_type);
+  static Response shared(std::shared_ptr<const std::vector<std::uint8_t>> body,
+                         std::string_view content_type);
+  // The body as sent: the shared one when set.
+  std::string_view body_bytes() const;
 
   // Replaces any field of the same name (case-insensitive).
   void set_header(std::string_view name, std::string_view value);
@@ -40,5 +51,9 @@ struct Response {
 // unless head_request. Header names that are not tokens are dropped and control characters in
 // values become spaces, so a handler echoing client input cannot split the response.
 std::string serialize(const Response& response, bool keep_alive, bool head_request);
+// The same without the body, and whether the body follows it on the wire, so that a server can
+// queue a shared body without copying it.
+std::string serialize_head(const Response& response, bool keep_alive);
+bool sends_body(const Response& response, bool head_request);
 
 }  // namespace scanplan::http

@@ -94,6 +94,17 @@ Response StaticFiles::serve(const Request& request) const {
   Response response = Response::bytes(std::move(*content), content_type_for(*file));
   response.set_header("X-Content-Type-Options", "nosniff");
   if (file->filename() == "index.html") response.set_header("Cache-Control", "no-cache");
+  // The page loads nothing from elsewhere: its scripts, its worker (which instantiates the Draco
+  // decoder's WebAssembly), styles, images from its layers and the API on its own origin. Should
+  // an injected string ever reach the DOM, it cannot load or run anything (issue 16); nor may
+  // another site frame the page to trick an operator into approving a move.
+  response.set_header("Content-Security-Policy",
+                      "default-src 'self'; script-src 'self' 'wasm-unsafe-eval'; "
+                      "worker-src 'self'; connect-src 'self'; img-src 'self' data: blob:; "
+                      "style-src 'self' 'unsafe-inline'; object-src 'none'; base-uri 'none'; "
+                      "form-action 'none'; frame-ancestors 'none'");
+  response.set_header("X-Frame-Options", "DENY");
+  response.set_header("Referrer-Policy", "no-referrer");
   return response;
 }
 

@@ -96,6 +96,18 @@ void Api::install(http::Router& router) {
   router.add("GET", "/api/v1/events", [this](const Request& r, const auto&) { return events(r); });
 }
 
+std::optional<Response> Api::admit(const Request& head) const {
+  const auto length = head.header("Content-Length");
+  const bool body = head.header("Transfer-Encoding") || (length && *length != "0");
+  if (!body) return std::nullopt;
+  try {
+    require(head, Role::kOperator);
+  } catch (const HttpError& e) {
+    return Response::error(e.status(), e.code(), e.what());
+  }
+  return std::nullopt;
+}
+
 void Api::require(const Request& request, Role needed) const {
   const Role role = auth_.role_of(request);
   if (role == Role::kNone) {
@@ -155,6 +167,17 @@ Response Api::events(const Request& r) const {
   if (role == Role::kNone) {
     return Response::error(401, "unauthorized",
                            "a valid token is required: ?token=T or Authorization: Bearer T");
+  }
+  // A browser names the page that opens the socket: only our own page may (another site could
+  // otherwise use a token it got hold of from the operator's browser). Clients that are not
+  // browsers send no Origin.
+  if (const auto origin = r.header("Origin")) {
+    const std::string_view host = r.header("Host").value_or("");
+    if (*origin != "http://" + std::string(host) && *origin != "https://" + std::string(host)) {
+      return Response::error(403, "forbidden_origin",
+                             "the events socket is only open to this server's own page, not to " +
+                                 std::string(origin->substr(0, 100)));
+    }
   }
   return http::websocket_handshake_response(r, app_.hub.adopt(r.peer));
 }

@@ -35,6 +35,10 @@ class Api {
  public:
   Api(ApiParts parts, const Auth& auth, std::string session_dir);
   void install(http::Router& router);
+  // http::ServerConfig::admit: a request that brings a body (every body goes to an operator's
+  // route) needs an operator token before a byte of it is read: 401 without a valid token, 403
+  // with a viewer's. Requests without a body are left to their route's own check.
+  std::optional<http::Response> admit(const http::Request& head) const;
 
  private:
   // Throws HttpError 401/403 unless the request carries a token with at least `needed`.

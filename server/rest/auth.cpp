@@ -5,6 +5,8 @@
 
 #include <stdexcept>
 
+#include "http/ascii.hpp"
+
 namespace scanplan::server {
 namespace {
 
@@ -22,11 +24,17 @@ Auth::Auth(std::string operator_token, std::string viewer_token)
 Role Auth::role_of(const http::Request& request) const {
   const auto header = request.header("Authorization");
   if (!header) return Role::kNone;
-  constexpr std::string_view kBearer = "Bearer ";
-  if (header->size() <= kBearer.size() || header->substr(0, kBearer.size()) != kBearer) {
+  // credentials = auth-scheme 1*SP token68, the scheme case-insensitive (RFC 9110 §11.4).
+  constexpr std::string_view kBearer = "bearer";
+  const std::string_view value = *header;
+  if (value.size() <= kBearer.size() ||
+      !http::ascii::iequals(value.substr(0, kBearer.size()), kBearer) ||
+      value[kBearer.size()] != ' ') {
     return Role::kNone;
   }
-  return role_of_token(header->substr(kBearer.size()));
+  std::string_view token = value.substr(kBearer.size());
+  while (!token.empty() && token.front() == ' ') token.remove_prefix(1);
+  return role_of_token(token);
 }
 
 Role Auth::role_of_token(std::string_view token) const {

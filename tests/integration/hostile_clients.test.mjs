@@ -4,6 +4,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
+import { connect } from 'node:net';
 import { existsSync, mkdtempSync, readdirSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
@@ -126,6 +127,73 @@ test('a target region of 1e9 m is refused and changes nothing; later changes and
   const r = await stack.api('POST', '/api/v1/scans?x=5&y=0&z=0&yaw_deg=0', { body: roomPly() });
   assert.equal(r.status, 201);
   await stack.waitFor('the second scan in the map', async () => ((await session()).scans === 2 ? true : undefined));
+});
+
+// Sends `text` on a raw TCP connection and resolves with everything the server sent back
+// before it closed (or `waitMs` passed), and whether it closed.
+function raw(text, { waitMs = 3000, keepSending } = {}) {
+  const { hostname, port } = new URL(stack.url);
+  return new Promise((resolve) => {
+    const socket = connect(Number(port), hostname);
+    let got = '';
+    let timer;
+    const done = (closed) => {
+      clearTimeout(timer);
+      clearInterval(socket.trickle);
+      socket.destroy();
+      resolve({ got, closed });
+    };
+    socket.on('data', (c) => { got += c.toString('latin1'); });
+    socket.on('close', () => done(true));
+    socket.on('error', () => done(true));
+    socket.on('connect', () => {
+      socket.write(text);
+      if (keepSending) socket.trickle = setInterval(() => socket.write(keepSending), 50);
+    });
+    timer = setTimeout(() => done(false), waitMs);
+  });
+}
+
+test('no token, no work: an upload is refused before its body is read', async () => {
+  const started = Date.now();
+  const refused = await raw('POST /api/v1/scans?x=0&y=0&z=0&yaw_deg=0 HTTP/1.1\r\nHost: h\r\n' +
+    'Content-Length: 200000000\r\nExpect: 100-continue\r\n\r\n');
+  assert.match(refused.got, /^HTTP\/1\.1 401 /);
+  assert.doesNotMatch(refused.got, /100 Continue/);
+  assert.ok(refused.closed);
+  assert.ok(Date.now() - started < 2000);
+  // Many at once, sending on: each is answered and let go, and the operators are still served.
+  const flood = Array.from({ length: 150 }, () => raw('PUT /api/v1/params HTTP/1.1\r\nHost: h\r\n' +
+    'Authorization: Bearer wrong\r\nContent-Length: 200000000\r\n\r\n', { keepSending: 'x'.repeat(4096), waitMs: 5000 }));
+  for (let i = 0; i < 20; i++) assert.equal((await stack.api('GET', '/api/v1/session')).status, 200);
+  for (const r of await Promise.all(flood)) assert.match(r.got, /^HTTP\/1\.1 401 /);
+  const viewer = await stack.api('POST', '/api/v1/scans?x=0&y=0&z=0&yaw_deg=0', { auth: stack.viewerToken, body: roomPly() });
+  assert.equal(viewer.status, 403);
+  const { url } = stack;
+  const lower = await fetch(url + '/api/v1/session', { headers: { Authorization: `bearer  ${stack.token}` } });
+  assert.equal(lower.status, 200, 'the Bearer scheme is case-insensitive');
+  assert.equal((await lower.json()).role, 'operator');
+});
+
+test('the page carries its security headers; the events socket checks Origin', async () => {
+  const page = await fetch(stack.url + '/');
+  assert.equal(page.status, 200);
+  assert.match(page.headers.get('content-security-policy'), /default-src 'self'.*frame-ancestors 'none'/);
+  assert.equal(page.headers.get('x-frame-options'), 'DENY');
+  assert.equal(page.headers.get('referrer-policy'), 'no-referrer');
+  const { host } = new URL(stack.url);
+  const upgrade = (origin) => raw(`GET /api/v1/events?token=${stack.token} HTTP/1.1\r\nHost: ${host}\r\n` +
+    'Upgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Version: 13\r\n' +
+    `Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n${origin ? `Origin: ${origin}\r\n` : ''}\r\n`, { waitMs: 1000 });
+  assert.match((await upgrade('http://evil.example')).got, /^HTTP\/1\.1 403 .*forbidden_origin/s);
+  assert.match((await upgrade(`http://${host}`)).got, /^HTTP\/1\.1 101 /);
+  assert.match((await upgrade(null)).got, /^HTTP\/1\.1 101 /, 'a client that is not a browser sends no Origin');
+});
+
+test('a request line with an absolute URI is served (RFC 9112 §3.2.2)', async () => {
+  const r = await raw(`GET ${stack.url}/api/v1/health HTTP/1.1\r\nHost: elsewhere\r\nConnection: close\r\n\r\n`);
+  assert.match(r.got, /^HTTP\/1\.1 200 /);
+  assert.match(r.got, /"status":"ok"/);
 });
 
 // Runs the server binary on `sessionDir` and returns its exit code and output.

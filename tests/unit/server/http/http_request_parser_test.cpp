@@ -107,6 +107,25 @@ TEST(HttpRequestParser, ParsesSimpleGet) {
   EXPECT_TRUE(r.keep_alive());
 }
 
+TEST(HttpRequestParser, AbsoluteFormIsTakenWithItsAuthorityAsTheHost) {
+  // RFC 9112 §3.2.2: a server must accept it; the target's authority overrides the Host field.
+  const auto result = parse(
+      "GET HTTP://example:8080/api/v1/scans?since=3 HTTP/1.1\r\nHost: other\r\n\r\n"
+      "GET http://example HTTP/1.1\r\n\r\n"
+      "GET http://example?x=1 HTTP/1.1\r\nHost: example\r\n\r\n");
+  ASSERT_EQ(result.error, 0) << result.message;
+  ASSERT_EQ(result.requests.size(), 3u);
+  const Request& r = result.requests[0];
+  EXPECT_EQ(r.target, "/api/v1/scans?since=3");
+  EXPECT_EQ(r.path, "/api/v1/scans");
+  EXPECT_EQ(r.query.at("since"), "3");
+  EXPECT_EQ(r.header("host"), "example:8080");
+  EXPECT_EQ(result.requests[1].path, "/");
+  EXPECT_EQ(result.requests[1].header("host"), "example");
+  EXPECT_EQ(result.requests[2].path, "/");
+  EXPECT_EQ(result.requests[2].query.at("x"), "1");
+}
+
 TEST(HttpRequestParser, DecodesPathAndQuery) {
   const auto result =
       parse("GET /a%20b/c%2Fd?x=1%2B1&name=a+b&flag&&empty=&x=second HTTP/1.1\r\nHost: h\r\n\r\n");
@@ -335,7 +354,10 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"version_garbage", "GET / HTTP/1.x\r\n" + kHost + "\r\n", 400},
         ErrorCase{"http2", "GET / HTTP/2.0\r\n" + kHost + "\r\n", 505},
         ErrorCase{"http12", "GET / HTTP/1.2\r\n" + kHost + "\r\n", 505},
-        ErrorCase{"absolute_form", "GET http://h/ HTTP/1.1\r\n" + kHost + "\r\n", 400},
+        ErrorCase{"absolute_form_userinfo", "GET http://u@h/ HTTP/1.1\r\n" + kHost + "\r\n", 400},
+        ErrorCase{"absolute_form_no_host", "GET http:///a HTTP/1.1\r\n" + kHost + "\r\n", 400},
+        ErrorCase{"other_scheme", "GET ftp://h/a HTTP/1.1\r\n" + kHost + "\r\n", 400},
+        ErrorCase{"authority_form", "CONNECT h:443 HTTP/1.1\r\n" + kHost + "\r\n", 400},
         ErrorCase{"asterisk_form", "OPTIONS * HTTP/1.1\r\n" + kHost + "\r\n", 400},
         ErrorCase{"control_in_target", "GET /a\x01 HTTP/1.1\r\n" + kHost + "\r\n", 400},
         ErrorCase{"non_ascii_target", "GET /caf\xc3\xa9 HTTP/1.1\r\n" + kHost + "\r\n", 400},

@@ -157,11 +157,13 @@ class Client {
 // A server on an ephemeral loopback port running on its own thread.
 class RunningServer {
  public:
-  RunningServer(HttpServer::Handler handler, Limits limits = {}) {
+  RunningServer(HttpServer::Handler handler, Limits limits = {},
+                decltype(ServerConfig::admit) admit = {}) {
     ServerConfig config;
     config.host = "127.0.0.1";
     config.port = 0;
     config.limits = limits;
+    config.admit = std::move(admit);
     config.log = [this](std::string_view m) {
       const std::lock_guard lock(log_mutex_);
       log_ += std::string(m) + "\n";
@@ -241,11 +243,16 @@ class HttpServerTest : public ::testing::Test {
     fs::remove_all(dir_);
   }
 
-  void start(Limits limits = {}) {
+  void start(Limits limits = {}, decltype(ServerConfig::admit) admit = {}) {
     auto router = router_;
     server_ = std::make_unique<RunningServer>(
-        [router](const Request& r) { return router->route(r); }, limits);
+        [router, this](const Request& r) {
+          ++handled_;
+          return router->route(r);
+        },
+        limits, std::move(admit));
   }
+  std::atomic<int> handled_{0};
   std::uint16_t port() const { return server_->port(); }
 
   fs::path dir_;
@@ -487,6 +494,147 @@ TEST_F(HttpServerTest, ExpectContinueRefusedBodyGets413Directly) {
   EXPECT_EQ(r->status, 413);
 }
 
+// Refuses any request with a body that does not say "Authorization: Bearer ok".
+std::optional<Response> token_check(const Request& head) {
+  if (!head.header("Content-Length") || head.header("Authorization") == "Bearer ok") {
+    return std::nullopt;
+  }
+  return Response::error(401, "unauthorized", "no token");
+}
+
+TEST_F(HttpServerTest, AdmissionIsDecidedBeforeTheBodyOrContinue) {
+  start({}, token_check);
+  {
+    // A 200 MB upload without a token: refused as soon as the headers are in, no 100 Continue,
+    // the body never read, the handler never run.
+    Client c(port());
+    ASSERT_TRUE(
+        c.send("POST /api/v1/scans HTTP/1.1\r\nHost: t\r\nContent-Length: 200000000\r\nExpect: "
+               "100-continue\r\n\r\n"));
+    const auto r = c.read_response();
+    ASSERT_TRUE(r.has_value());
+    EXPECT_EQ(r->status, 401);
+    EXPECT_TRUE(c.closed_by_server());
+  }
+  {
+    // Without Expect the client sends on; the answer still comes before the body is in.
+    Client c(port());
+    ASSERT_TRUE(
+        c.send("POST /api/v1/scans HTTP/1.1\r\nHost: t\r\nContent-Length: 200000000\r\n\r\n" +
+               big_body(1 << 16)));
+    const auto r = c.read_response();
+    ASSERT_TRUE(r.has_value());
+    EXPECT_EQ(r->status, 401);
+  }
+  EXPECT_EQ(handled_.load(), 0);
+  Client ok(port());
+  const auto r = ok.request("POST", "/api/v1/scans", "hello", "Authorization: Bearer ok\r\n");
+  EXPECT_EQ(r.status, 201);
+  EXPECT_EQ(r.json()["bytes"], 5);
+  EXPECT_EQ(ok.request("GET", "/api/v1/health").status, 200) << "bodyless requests pass";
+}
+
+TEST_F(HttpServerTest, ABodyTricklingBelowTheMinimumRateGets408) {
+  Limits limits;
+  limits.min_body_bytes_per_s = 1000;
+  limits.body_grace = 300ms;
+  start(limits);
+  Client c(port());
+  ASSERT_TRUE(c.send("POST /api/v1/scans HTTP/1.1\r\nHost: t\r\nContent-Length: 100000\r\n\r\n"));
+  // 10 bytes every 100 ms: never a stall (body_timeout keeps resetting), but 100 bytes/s.
+  const auto started = std::chrono::steady_clock::now();
+  std::atomic<bool> answered{false};
+  std::thread trickle([&] {
+    for (int i = 0; i < 30 && !answered; ++i) {
+      std::this_thread::sleep_for(100ms);
+      if (!c.send("0123456789")) break;
+    }
+  });
+  const auto r = c.read_response();
+  answered = true;
+  trickle.join();
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->status, 408);
+  EXPECT_NE(r->json()["error"]["message"].get<std::string>().find("slower than 1000 bytes/s"),
+            std::string::npos);
+  // The grace period and the few bytes' allowance, not the 30 s of trickle a stall would allow.
+  EXPECT_LT(std::chrono::steady_clock::now() - started, 1500ms);
+}
+
+TEST_F(HttpServerTest, ABodyAtTheMinimumRateIsReceived) {
+  Limits limits;
+  limits.min_body_bytes_per_s = 1000;
+  limits.body_grace = 200ms;
+  start(limits);
+  Client c(port());
+  ASSERT_TRUE(c.send("POST /api/v1/scans HTTP/1.1\r\nHost: t\r\nContent-Length: 1000\r\n\r\n"));
+  for (int i = 0; i < 5; ++i) {
+    std::this_thread::sleep_for(100ms);
+    ASSERT_TRUE(c.send(big_body(200)));  // 2000 bytes/s
+  }
+  const auto r = c.read_response();
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->status, 201);
+}
+
+TEST_F(HttpServerTest, OneAddressCannotTakeEveryConnection) {
+  Limits limits;
+  limits.max_connections_per_address = 2;
+  start(limits);
+  Client a(port());
+  Client b(port());
+  EXPECT_EQ(a.request("GET", "/api/v1/health").status, 200);
+  EXPECT_EQ(b.request("GET", "/api/v1/health").status, 200);
+  Client c(port());
+  const auto r = c.read_response();
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->status, 503);
+  EXPECT_NE(r->json()["error"]["message"].get<std::string>().find("this address already holds 2"),
+            std::string::npos);
+  b.close();
+  c.close();  // refused, it held its place until it went
+  std::this_thread::sleep_for(100ms);
+  Client d(port());
+  EXPECT_EQ(d.request("GET", "/api/v1/health").status, 200)
+      << "a closed connection frees its place";
+}
+
+TEST_F(HttpServerTest, UnreadResponsesAreBoundedInBytes) {
+  // Each response is 8 MB; with a 16 MB cap the server stops reading the pipeline after two,
+  // however many requests wait, until the client reads.
+  Limits limits;
+  limits.max_queued_bytes = 16 << 20;
+  start(limits);
+  Client c(port());
+  std::string burst;
+  for (int i = 0; i < 20; ++i) burst += "GET /api/v1/big HTTP/1.1\r\nHost: t\r\n\r\n";
+  ASSERT_TRUE(c.send(burst));
+  std::this_thread::sleep_for(300ms);
+  EXPECT_LE(handled_.load(), 4) << "requests stay unread while their answers sit unsent";
+  for (int i = 0; i < 20; ++i) {
+    const auto r = c.read_response();
+    ASSERT_TRUE(r.has_value()) << i;
+    ASSERT_EQ(r->body.size(), 8u << 20);
+  }
+  EXPECT_EQ(handled_.load(), 20);
+}
+
+TEST_F(HttpServerTest, SharedBodiesGoOutWhole) {
+  auto blob = std::make_shared<const std::string>(big_body(3 << 20));
+  router_->add("GET", "/api/v1/shared", [blob](const Request&, const Router::Params&) {
+    return Response::shared(blob, "application/octet-stream");
+  });
+  start();
+  Client c(port());
+  for (int i = 0; i < 3; ++i) {
+    const auto r = c.request("GET", "/api/v1/shared");
+    EXPECT_EQ(r.status, 200);
+    EXPECT_TRUE(r.body == *blob);
+  }
+  const auto head = c.request("HEAD", "/api/v1/shared");
+  EXPECT_EQ(head.header("content-length"), std::to_string(3 << 20));
+}
+
 TEST_F(HttpServerTest, ConnectionCloseAndHttp10) {
   start();
   {
@@ -618,7 +766,7 @@ TEST_F(HttpServerTest, UpgradeHandsTheSocketOver) {
 }
 
 TEST(HttpServer, StopEndsRun) {
-  HttpServer server({"127.0.0.1", 0, {}, [](std::string_view) {}},
+  HttpServer server({"127.0.0.1", 0, {}, [](std::string_view) {}, false, {}},
                     [](const Request&) { return Response::json(200, {}); });
   server.start();
   EXPECT_NE(server.port(), 0);
@@ -631,7 +779,7 @@ TEST(HttpServer, StopEndsRun) {
 }
 
 TEST(HttpServer, StopBeforeRunMakesRunReturn) {
-  HttpServer server({"127.0.0.1", 0, {}, {}}, [](const Request&) { return Response{}; });
+  HttpServer server({"127.0.0.1", 0, {}, {}, false, {}}, [](const Request&) { return Response{}; });
   server.start();
   server.stop();
   auto done = std::async(std::launch::async, [&] { server.run(); });
@@ -645,7 +793,8 @@ TEST(HttpServer, RunBeforeStartThrows) {
 
 TEST(HttpServer, BusyPortGivesAClearError) {
   RunningServer first([](const Request&) { return Response{}; });
-  HttpServer second({"127.0.0.1", first.port(), {}, {}}, [](const Request&) { return Response{}; });
+  HttpServer second({"127.0.0.1", first.port(), {}, {}, false, {}},
+                    [](const Request&) { return Response{}; });
   try {
     second.start();
     FAIL() << "binding a port in use must fail";
