@@ -8,7 +8,7 @@ WEB_SOURCES := $(wildcard web/src/*) web/index.html web/build.mjs web/package.js
 # In CI (CI set in the environment) warnings are errors.
 CMAKE_FLAGS := -DCMAKE_BUILD_TYPE=Release $(if $(CI),-DSCANPLAN_WERROR=ON,-DSCANPLAN_WERROR=OFF)
 
-.PHONY: all deps web build test demo format check-sanitizers clean
+.PHONY: all deps web build test demo format check-sanitizers fuzz clean
 
 all: build
 
@@ -43,5 +43,10 @@ format:
 check-sanitizers: deps web
 	JOBS=$(JOBS) scripts/check-sanitizers.sh
 
+# The fuzz targets under libFuzzer with ASan+UBSan (build-fuzz/), FUZZ_SECONDS each (default 120);
+# not part of make test, which replays their corpora. Figures: docs/architecture.md.
+fuzz: deps
+	JOBS=$(JOBS) scripts/fuzz.sh
+
 clean:
-	rm -rf $(BUILD) build-asan build-tsan web/dist
+	rm -rf $(BUILD) build-asan build-tsan build-fuzz web/dist

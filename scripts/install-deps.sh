@@ -12,6 +12,8 @@ packages=(
 )
 # Benchmarks only (tests/bench/http_bench.sh): the load generator and the baseline server.
 [ "${1:-}" = "--bench" ] && packages+=(wrk nginx-light)
+# make fuzz only: clang with its libFuzzer and sanitizer runtimes.
+[ "${1:-}" = "--fuzz" ] && packages+=(clang)
 
 missing=()
 for p in "${packages[@]}"; do

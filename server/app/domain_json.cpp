@@ -57,7 +57,11 @@ json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas) {
           {"placed", pose_json(s.placed)},
           {"received_at", s.received_at},
           {"match", match_json(s.match)},
-          {"areas", areas ? areas_json(*areas) : json(nullptr)}};
+          {"areas", areas ? areas_json(*areas) : json(nullptr)},
+          {"excluded", s.excluded ? json{{"by", s.excluded->by},
+                                         {"reason", s.excluded->reason},
+                                         {"at", s.excluded->at}}
+                                  : json(nullptr)}};
 }
 
 json candidate_json(const CandidateRecord& r, const std::string& robot, std::uint64_t plan) {

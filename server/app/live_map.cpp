@@ -32,12 +32,11 @@ LiveMap::~LiveMap() {
 void LiveMap::encode_loop() {
   std::unique_lock lock(mutex_);
   for (;;) {
-    encode_wanted_.wait(lock, [&] {
-      return stopping_ || (!scans_.empty() && encoded_last_scan_ != scans_.back().id);
-    });
+    encode_wanted_.wait(lock, [&] { return stopping_ || encoded_generation_ != generation_; });
     if (stopping_) return;
     const auto parts = placed_;
-    const std::int64_t last = scans_.back().id;
+    const std::int64_t last = scans_.empty() ? 0 : scans_.back().id;
+    const std::uint64_t generation = generation_;
     const std::size_t count = point_count_;
     lock.unlock();
     std::shared_ptr<const std::string> encoded;
@@ -51,12 +50,14 @@ void LiveMap::encode_loop() {
       // last_scan and can fetch the rest with ?since.
       lock.lock();
       encoded_last_scan_ = last;
+      encoded_generation_ = generation;
       encoded_changed_.notify_all();
       continue;
     }
     lock.lock();
     encoded_ = std::move(encoded);
     encoded_last_scan_ = last;
+    encoded_generation_ = generation;
     encoded_changed_.notify_all();
   }
 }
@@ -95,6 +96,7 @@ std::vector<PlanRecord> LiveMap::add(const StoredScan& scan, const PointCloud& c
   scan_pose_of_[scan.robot] = pose;
   const auto plans = refresh_derived([&] {
     scans_.push_back(scan);
+    ++generation_;
     chunks_[scan.id] = chunk;
     point_count_ += shared->size();
     placed_.push_back(std::move(shared));
@@ -354,11 +356,85 @@ Bounds3 LiveMap::bounds() const {
   return bounds_;
 }
 
+std::vector<PlanRecord> LiveMap::rebuild(const std::vector<StoredScan>& keep,
+                                         const ScanLoader& load,
+                                         const std::function<void(std::size_t)>& progress) {
+  std::lock_guard encode_lock(encode_mutex_);
+  std::map<std::int64_t,
+           std::pair<std::shared_ptr<const PointCloud>, std::shared_ptr<const std::string>>>
+      held;
+  {
+    std::lock_guard lock(mutex_);
+    for (std::size_t i = 0; i < scans_.size(); ++i) {
+      const auto chunk = chunks_.find(scans_[i].id);
+      held[scans_[i].id] = {placed_[i], chunk == chunks_.end() ? nullptr : chunk->second};
+    }
+  }
+  // A new pipeline fed the kept scans in their order, at their placed poses: the MLS map, the
+  // anchored map and the sensors' frame as if the others had never come. The map frame and the
+  // target region stay.
+  MissionPipeline fresh(mission_.config());
+  fresh.set_planner(mission_.planner());
+  if (const auto& target = mission_.mapping().target()) fresh.set_target(*target);
+  VoxelMap thinned{kThinnedMapVoxelM};
+  std::vector<StoredScan> scans;
+  std::vector<std::shared_ptr<const PointCloud>> placed;
+  std::map<std::int64_t, std::shared_ptr<const std::string>> chunks;
+  std::map<std::string, Pose> pose_of;
+  Bounds3 bounds;
+  std::size_t count = 0;
+  for (const StoredScan& s : keep) {
+    auto [in_map, chunk] = held.count(s.id) ? held[s.id] : decltype(held)::mapped_type{};
+    if (!in_map) in_map = MissionPipeline::to_map_frame(load(s), s.placed);
+    if (!chunk && !in_map->empty()) {
+      chunk = std::make_shared<const std::string>(encode_draco(*in_map));
+    }
+    // The pipeline wants the scan in its own frame: the map-frame points carried back.
+    const Eigen::Affine3f scan_from_map = s.placed.isometry().inverse().cast<float>();
+    PointCloud own;
+    own.reserve(in_map->size());
+    for (std::size_t i = 0; i < in_map->size(); ++i) {
+      own.push_back(scan_from_map * in_map->points[i], in_map->colors[i]);
+    }
+    fresh.add(own, {s.estimated, s.placed, s.match && s.match->applied}, in_map);
+    thinned.add(*in_map);
+    const Bounds3 b = bounds_of(*in_map);
+    if (b.valid()) {
+      bounds.extend(b.min);
+      bounds.extend(b.max);
+    }
+    count += in_map->size();
+    pose_of[s.robot] = s.placed;
+    scans.push_back(s);
+    placed.push_back(std::move(in_map));
+    chunks[s.id] = std::move(chunk);
+    if (progress) progress(scans.size());
+  }
+  mission_ = std::move(fresh);
+  thinned_ = std::move(thinned);
+  // Where each robot last scanned stays where it is: the robot has not moved.
+  for (const auto& [robot, pose] : pose_of) scan_pose_of_.try_emplace(robot, pose);
+  const auto plans = refresh_derived([&] {
+    scans_ = std::move(scans);
+    placed_ = std::move(placed);
+    chunks_ = std::move(chunks);
+    point_count_ = count;
+    bounds_ = bounds;
+    ++generation_;
+  });
+  encode_wanted_.notify_one();
+  if (on_map) on_map(thinned_.cloud());
+  if (on_plan) {
+    for (const PlanRecord& plan : plans) on_plan(plan);
+  }
+  return plans;
+}
+
 LiveMap::EncodedMap LiveMap::encoded_map(std::chrono::milliseconds wait) const {
   std::unique_lock lock(mutex_);
   if (scans_.empty()) return {};
   encoded_changed_.wait_for(lock, wait,
-                            [&] { return stopping_ || encoded_last_scan_ == scans_.back().id; });
+                            [&] { return stopping_ || encoded_generation_ == generation_; });
   return {encoded_, encoded_last_scan_};
 }
 

@@ -91,6 +91,14 @@ class LiveMap {
   // not driving to a goal; the scanning robot's last).
   std::vector<PlanRecord> add(const StoredScan& scan, const PointCloud& cloud);
 
+  // The map made anew from `keep` (stored scans, in id order, at their placed poses): after the
+  // operator took a scan out or put one back. Points of scans the map holds are reused; the
+  // others come from `load` (the scan in its own frame). `progress` is told how many are in.
+  // Returns the new plans, as add() does.
+  using ScanLoader = std::function<PointCloud(const StoredScan&)>;
+  std::vector<PlanRecord> rebuild(const std::vector<StoredScan>& keep, const ScanLoader& load,
+                                  const std::function<void(std::size_t)>& progress = {});
+
   std::vector<StoredScan> scans() const;
   // Where a new scan goes: matched against the map so far (MissionPipeline::place). Nothing when
   // matching is off or the map is empty. Call from the thread that calls add().
@@ -146,6 +154,10 @@ class LiveMap {
   Bounds3 bounds_;  // of all points, kept as scans arrive: the session endpoint is polled often
   std::shared_ptr<const std::string> encoded_;  // the whole map up to encoded_last_scan_
   std::int64_t encoded_last_scan_ = 0;
+  // Counts every change of the map's scans (a scan joined, the map rebuilt); the encoder
+  // catches up with it, and encoded_map() waits for it.
+  std::uint64_t generation_ = 0;
+  std::uint64_t encoded_generation_ = 0;
   mutable std::condition_variable encoded_changed_;  // with mutex_
   std::condition_variable encode_wanted_;            // with mutex_
   bool stopping_ = false;

@@ -39,6 +39,11 @@ void ScanIntake::start() {
         std::lock_guard lock(mutex_);
         if (stop_) return;
       }
+      if (s.excluded) {
+        std::lock_guard lock(mutex_);
+        ++rebuild_->done;
+        continue;
+      }
       std::string problem;
       if (const auto why = implausible_pose(s.placed)) {
         problem = "its stored pose is not a place: " + *why;
@@ -107,7 +112,7 @@ SubmittedScan ScanIntake::submit(const std::string& robot, const Pose& estimated
   StoredScan stored = session_.add_scan(robot, estimated, estimated, stamp_ns, cloud);
   {
     std::lock_guard lock(mutex_);
-    queue_.emplace_back(stored, std::move(cloud));
+    queue_.push_back({stored, std::move(cloud)});
   }
   wake_.notify_one();
   events_.publish("scan_received", {{"scan", stored.id},
@@ -171,7 +176,96 @@ void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud) {
 
 std::size_t ScanIntake::pending() const {
   std::lock_guard lock(mutex_);
-  return queue_.size();
+  return static_cast<std::size_t>(
+      std::count_if(queue_.begin(), queue_.end(), [](const Job& j) { return j.scan.has_value(); }));
+}
+
+StoredScan ScanIntake::set_excluded(std::int64_t id, bool excluded, const std::string& by,
+                                    const std::string& reason) {
+  std::lock_guard lock(exclusion_mutex_);
+  const std::optional<StoredScan> now = session_.scan(id);
+  if (!now) throw ExclusionError("not_found", "no scan " + std::to_string(id) + " in this session");
+  if (excluded && now->excluded) {
+    throw ExclusionError("already_excluded", "scan " + std::to_string(id) +
+                                                 " is already out of the map (taken out by " +
+                                                 now->excluded->by + ")");
+  }
+  if (!excluded && !now->excluded) {
+    throw ExclusionError("not_excluded", "scan " + std::to_string(id) + " is in the map");
+  }
+  if (excluded) {
+    const std::vector<StoredScan> all = session_.scans();
+    const auto in_map =
+        std::count_if(all.begin(), all.end(), [](const StoredScan& s) { return !s.excluded; });
+    if (in_map <= 1) {
+      throw ExclusionError("last_scan",
+                           "scan " + std::to_string(id) +
+                               " is the only one in the map: taking it out would leave nothing "
+                               "to plan on");
+    }
+  }
+  const std::optional<StoredScan> after = session_.set_excluded(id, excluded, by, reason);
+  if (!after)
+    throw ExclusionError("not_found", "no scan " + std::to_string(id) + " in this session");
+  events_.publish(excluded ? "scan_excluded" : "scan_restored",
+                  {{"scan", id}, {"by", by}, {"reason", reason}});
+  {
+    std::lock_guard queue_lock(mutex_);
+    queue_.push_back({});
+  }
+  wake_.notify_one();
+  return *after;
+}
+
+std::vector<StoredScan> ScanIntake::excluded_scans() const {
+  std::vector<StoredScan> out = session_.scans();
+  std::erase_if(out, [](const StoredScan& s) { return !s.excluded; });
+  return out;
+}
+
+void ScanIntake::rebuild_map() {
+  std::vector<StoredScan> keep;
+  for (StoredScan& s : session_.scans()) {
+    if (s.excluded) continue;
+    // A scan still queued joins with its own job; one that never came back stays out.
+    {
+      std::lock_guard lock(mutex_);
+      const bool queued = std::any_of(queue_.begin(), queue_.end(),
+                                      [&](const Job& j) { return j.scan && j.scan->id == s.id; });
+      const bool missing = std::any_of(not_in_map_.begin(), not_in_map_.end(),
+                                       [&](const NotInMap& n) { return n.id == s.id; });
+      if (queued || missing) continue;
+    }
+    keep.push_back(std::move(s));
+  }
+  {
+    std::lock_guard lock(mutex_);
+    rebuild_ = Rebuild{0, keep.size()};
+  }
+  std::vector<PlanRecord> plans;
+  try {
+    plans = live_.rebuild(
+        keep, [this](const StoredScan& s) { return session_.load_points(s); },
+        [this](std::size_t done) {
+          std::lock_guard lock(mutex_);
+          if (rebuild_) rebuild_->done = done;
+        });
+  } catch (const std::exception& e) {
+    spdlog::error("the map could not be rebuilt: {}", e.what());
+  }
+  {
+    std::lock_guard lock(mutex_);
+    rebuild_.reset();
+  }
+  const MapAreas a = live_.areas();
+  events_.publish("map_rebuilt", {{"scans", keep.size()},
+                                  {"completed_m2", a.completed_m2},
+                                  {"low_resolution_m2", a.low_resolution_m2},
+                                  {"unscanned_m2", a.unscanned_m2},
+                                  {"movable_m2", a.movable_m2}});
+  std::sort(plans.begin(), plans.end(),
+            [](const PlanRecord& p, const PlanRecord& q) { return p.robot < q.robot; });
+  for (const PlanRecord& plan : plans) events_.publish("plan_done", plan_done_json(plan));
 }
 
 std::vector<ScanIntake::NotInMap> ScanIntake::not_in_map() const {
@@ -191,23 +285,27 @@ std::optional<ScanIntake::StorageFailure> ScanIntake::last_storage_failure() con
 
 void ScanIntake::loop() {
   for (;;) {
-    std::pair<StoredScan, PointCloud> next;
+    Job job;
     {
       std::unique_lock lock(mutex_);
       wake_.wait(lock, [&] { return stop_ || !queue_.empty(); });
       if (stop_) return;
-      next = std::move(queue_.front());
+      job = std::move(queue_.front());
     }
-    try {
-      next.first = match(next.first, next.second);
-      process(next.first, next.second);
-      spdlog::info("scan {} from '{}' is in the map: {} points at ({:.2f}, {:.2f}, {:.2f})",
-                   next.first.id, next.first.robot, next.first.points, next.first.placed.x,
-                   next.first.placed.y, next.first.placed.z);
-    } catch (const std::exception& e) {
-      spdlog::error("scan {} could not join the map: {}", next.first.id, e.what());
-      std::lock_guard lock(mutex_);
-      not_in_map_.push_back({next.first.id, next.first.robot, e.what()});
+    if (!job.scan) {
+      rebuild_map();
+    } else {
+      StoredScan& scan = *job.scan;
+      try {
+        scan = match(scan, job.cloud);
+        process(scan, job.cloud);
+        spdlog::info("scan {} from '{}' is in the map: {} points at ({:.2f}, {:.2f}, {:.2f})",
+                     scan.id, scan.robot, scan.points, scan.placed.x, scan.placed.y, scan.placed.z);
+      } catch (const std::exception& e) {
+        spdlog::error("scan {} could not join the map: {}", scan.id, e.what());
+        std::lock_guard lock(mutex_);
+        not_in_map_.push_back({scan.id, scan.robot, e.what()});
+      }
     }
     std::lock_guard lock(mutex_);
     queue_.pop_front();

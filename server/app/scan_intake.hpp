@@ -30,6 +30,15 @@ class InvalidScanError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Taking a scan out of the map or putting it back cannot be done: `code` says why (not_found,
+// already_excluded, not_excluded, last_scan).
+class ExclusionError : public std::runtime_error {
+ public:
+  ExclusionError(std::string code_, const std::string& message)
+      : std::runtime_error(message), code(std::move(code_)) {}
+  std::string code;
+};
+
 // A scan accepted: as stored, and what was dropped from it on the way in.
 struct SubmittedScan {
   StoredScan scan;
@@ -66,6 +75,15 @@ class ScanIntake {
   // Scans stored but not yet in the live map.
   std::size_t pending() const;
 
+  // The operator takes scan `id` out of the map (`excluded`), or puts it back: recorded in the
+  // session with who and why (the scan's file stays), published (scan_excluded /
+  // scan_restored), and the map rebuilt without it (or with it) on the worker, after the scans
+  // queued before. Returns the scan as it now stands. Thread-safe. Throws ExclusionError.
+  StoredScan set_excluded(std::int64_t id, bool excluded, const std::string& by,
+                          const std::string& reason);
+  // The scans the operator keeps out of the map, in id order.
+  std::vector<StoredScan> excluded_scans() const;
+
   // A stored scan that is not in the map: on reopening the session its file was missing or
   // damaged or its stored pose no place, or the map could not take it.
   struct NotInMap {
@@ -99,8 +117,16 @@ class ScanIntake {
   LiveMap& live_;
   const Events& events_;
   mutable std::mutex mutex_;
+  std::mutex exclusion_mutex_;  // one exclusion or restoration at a time, checked and recorded
   std::condition_variable wake_;
-  std::deque<std::pair<StoredScan, PointCloud>> queue_;
+  // What the worker does next: a new scan into the map, or (no scan) a rebuild of the map from
+  // the session's scans that are not excluded.
+  struct Job {
+    std::optional<StoredScan> scan;
+    PointCloud cloud;
+  };
+  std::deque<Job> queue_;
+  void rebuild_map();
   bool stop_ = false;
   std::vector<NotInMap> not_in_map_;
   std::optional<Rebuild> rebuild_;

@@ -139,6 +139,18 @@ std::string describe_event(const json& e) {
            fixed(num(e, "unscanned_m2"), 0) + " m2, movable " + fixed(num(e, "movable_m2"), 0) +
            " m2";
   }
+  if (type == "scan_excluded" || type == "scan_restored") {
+    const std::string reason = str(e, "reason");
+    return "scan " + str(e, "scan") +
+           (type == "scan_excluded" ? " taken out of the map by " : " put back into the map by ") +
+           str(e, "by") + (reason.empty() ? "" : ": " + reason);
+  }
+  if (type == "map_rebuilt") {
+    return "map rebuilt from " + str(e, "scans") + " scans: completed " +
+           fixed(num(e, "completed_m2"), 0) + " m2, movable " + fixed(num(e, "movable_m2"), 0) +
+           " m2";
+  }
+  if (type == "storage_failed") return "STORAGE FAILED: " + str(e, "message");
   if (type == "plan_done") {
     return "plan " + str(e, "plan") + " after scan " + str(e, "based_on_scan") + ": " +
            str(e, "candidates") + " candidates in " + fixed(num(e, "plan_ms"), 0) + " ms";

@@ -50,6 +50,14 @@ void Api::install(http::Router& router) {
     require(r, Role::kOperator);
     return post_scan(r);
   });
+  router.add("DELETE", "/api/v1/scans/{id}", [this](const Request& r, const auto& params) {
+    require(r, Role::kOperator);
+    return set_scan_excluded(r, params.at("id"), true);
+  });
+  router.add("POST", "/api/v1/scans/{id}/restore", [this](const Request& r, const auto& params) {
+    require(r, Role::kOperator);
+    return set_scan_excluded(r, params.at("id"), false);
+  });
   router.add("GET", "/api/v1/candidates", [this](const Request& r, const auto&) {
     require(r, Role::kViewer);
     return candidates(r);

@@ -52,6 +52,9 @@ class Api {
   http::Response post_scan(const http::Request& request);
   http::Response list_scans() const;
   http::Response get_scan(const std::string& id) const;
+  // DELETE /api/v1/scans/{id} (excluded) and POST /api/v1/scans/{id}/restore.
+  http::Response set_scan_excluded(const http::Request& request, const std::string& id,
+                                   bool excluded);
   http::Response candidates(const http::Request& request) const;
   http::Response get_params() const;
   http::Response put_params(const http::Request& request);

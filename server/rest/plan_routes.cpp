@@ -35,12 +35,7 @@ HttpError http_error(const MissionError& e) {
 
 }  // namespace rest
 
-namespace {
-
-// A reject's reason is kept in the session and shown to every operator: a sentence or two.
-constexpr std::size_t kMaxReasonBytes = 2000;
-
-}  // namespace
+namespace {}  // namespace
 
 Response Api::candidates(const Request& request) const {
   // One plan per robot; the newest (the robot whose scan came last) first.
@@ -75,7 +70,7 @@ Response Api::decide(const Request& request, const std::string& id, const std::s
                              "the body, when given, is {\"by\": \"name\", \"reason\": \"...\"}");
   }
   const std::string by = rest::decided_by(body);
-  const std::string reason = rest::text_in(body, "reason", kMaxReasonBytes, TextKind::kProse);
+  const std::string reason = rest::text_in(body, "reason", rest::kMaxReasonBytes, TextKind::kProse);
   try {
     if (action == "approve") return Response::json(200, approval_json(app_.mission.approve(n, by)));
     if (action == "reject") {

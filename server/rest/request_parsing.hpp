@@ -35,6 +35,10 @@ std::string robot_in(const std::string& text);
 // (1 to `max_bytes` bytes).
 std::string author_of(const nlohmann::json& body, std::size_t max_bytes = 64);
 
+// A reason (a reject's, a scan taken out of the map) is kept in the session and shown to every
+// operator: a sentence or two.
+inline constexpr std::size_t kMaxReasonBytes = 2000;
+
 // A coordinate beyond this is a unit mistake (millimetres, a GPS longitude in the wrong field),
 // not a place: PoseLimits::max_xy_m, the bound on the poses scans come with.
 inline constexpr double kMaxCoordinateM = PoseLimits{}.max_xy_m;

@@ -110,14 +110,46 @@ Response Api::list_scans() const {
   json list = json::array();
   for (const StoredScan& s : app_.map.scans())
     list.push_back(scan_json(s, app_.map.areas_after(s.id)));
+  json excluded = json::array();
+  for (const StoredScan& s : app_.intake.excluded_scans()) {
+    excluded.push_back(scan_json(s, app_.map.areas_after(s.id)));
+  }
   return Response::json(200, {{"scans", list},
                               {"pending", app_.intake.pending()},
+                              {"excluded", excluded},
                               {"not_in_map", not_in_map_json(app_.intake.not_in_map())}});
+}
+
+Response Api::set_scan_excluded(const Request& request, const std::string& id, bool excluded) {
+  const auto n = static_cast<std::int64_t>(rest::path_id(id, "a scan id"));
+  json body = json::object();
+  if (!request.body.empty()) {
+    body = rest::object_body(request,
+                             "the body, when given, is {\"by\": \"name\", \"reason\": \"...\"}");
+  }
+  for (const auto& [key, value] : body.items()) {
+    if (key != "by" && key != "reason")
+      throw HttpError(400, "bad_request", "unknown field '" + key + "'");
+  }
+  const std::string by = rest::decided_by(body);
+  const std::string reason = rest::text_in(body, "reason", rest::kMaxReasonBytes, TextKind::kProse);
+  try {
+    const StoredScan s = app_.intake.set_excluded(n, excluded, by, reason);
+    return Response::json(200, scan_json(s, app_.map.areas_after(s.id)));
+  } catch (const ExclusionError& e) {
+    throw HttpError(e.code == "not_found" ? 404 : 409, e.code, e.what());
+  } catch (const SessionStoreError& e) {
+    throw HttpError(503, "storage_failed",
+                    std::string("the session could not record it: ") + e.what());
+  }
 }
 
 Response Api::get_scan(const std::string& id) const {
   const auto n = static_cast<std::int64_t>(rest::path_id(id, "a scan id"));
   for (const StoredScan& s : app_.map.scans()) {
+    if (s.id == n) return Response::json(200, scan_json(s, app_.map.areas_after(s.id)));
+  }
+  for (const StoredScan& s : app_.intake.excluded_scans()) {
     if (s.id == n) return Response::json(200, scan_json(s, app_.map.areas_after(s.id)));
   }
   throw HttpError(404, "not_found", "no scan " + id + " in this session");

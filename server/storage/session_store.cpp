@@ -95,10 +95,14 @@ constexpr const char* kScanColumns =
     "id, robot, est_x, est_y, est_z, est_roll, est_pitch, est_yaw, x, y, z, roll, pitch, yaw, "
     "stamp_ns, points, file, received_at";
 // A scan with its match, if it has one: scan_from_row reads these columns.
+// With its latest exclusion record, which says whether it is out of the map now.
 const std::string kScanSelect =
     std::string("SELECT ") + kScanColumns +
-    ", applied, converged, method, reason, time_ms, inlier_ratio FROM scans LEFT JOIN matches "
-    "ON matches.scan_id = scans.id";
+    ", applied, converged, method, matches.reason, time_ms, inlier_ratio, "
+    "ex.excluded, ex.actor, ex.reason, ex.at FROM scans LEFT JOIN matches "
+    "ON matches.scan_id = scans.id LEFT JOIN (SELECT scan_id, excluded, actor, reason, at FROM "
+    "exclusions WHERE id IN (SELECT MAX(id) FROM exclusions GROUP BY scan_id)) ex "
+    "ON ex.scan_id = scans.id";
 
 StoredScan scan_from_row(const Statement& s) {
   StoredScan r;
@@ -114,6 +118,7 @@ StoredScan scan_from_row(const Statement& s) {
     r.match = StoredMatch{s.integer(18) != 0, s.integer(19) != 0, s.text(20),
                           s.text(21),         s.real(22),         s.real(23)};
   }
+  if (!s.null(24) && s.integer(24) != 0) r.excluded = Exclusion{s.text(25), s.text(26), s.text(27)};
   return r;
 }
 
@@ -206,6 +211,11 @@ SessionStore::SessionStore(std::filesystem::path dir) : dir_(created(std::move(d
       "x REAL NOT NULL, y REAL NOT NULL, z REAL NOT NULL, text TEXT NOT NULL, "
       "author TEXT NOT NULL, created_ns INTEGER NOT NULL, created_at TEXT NOT NULL, "
       "deleted_at TEXT, deleted_by TEXT)");
+  // Every exclusion and restoration, in order: the latest row per scan is its state.
+  exec(
+      "CREATE TABLE IF NOT EXISTS exclusions(id INTEGER PRIMARY KEY, scan_id INTEGER NOT NULL "
+      "REFERENCES scans(id), excluded INTEGER NOT NULL, actor TEXT NOT NULL, reason TEXT NOT NULL, "
+      "at TEXT NOT NULL)");
   if (!had_database) {
     if (const auto files = scan_files(dir_); !files.empty()) {
       sqlite3_close(db_);
@@ -320,6 +330,37 @@ void SessionStore::record_match(std::int64_t id, const StoredMatch& m, const Pos
     s.bind(7, id);
     s.step();
     exec("COMMIT");
+  } catch (...) {
+    exec("ROLLBACK");
+    throw;
+  }
+}
+
+std::optional<StoredScan> SessionStore::set_excluded(std::int64_t id, bool excluded,
+                                                     const std::string& by,
+                                                     const std::string& reason) {
+  std::lock_guard lock(mutex_);
+  exec("BEGIN IMMEDIATE");
+  try {
+    {
+      Statement known(db_, "SELECT COUNT(*) FROM scans WHERE id = ?");
+      known.bind(1, id);
+      known.step();
+      if (known.integer(0) == 0) {
+        exec("ROLLBACK");
+        return std::nullopt;
+      }
+    }
+    Statement ins(db_,
+                  "INSERT INTO exclusions(scan_id, excluded, actor, reason, at) VALUES(?,?,?,?,?)");
+    ins.bind(1, id).bind(2, std::int64_t{excluded}).bind(3, by).bind(4, reason).bind(5, utc_now());
+    ins.step();
+    Statement s(db_, (kScanSelect + " WHERE scans.id = ?").c_str());
+    s.bind(1, id);
+    s.step();
+    StoredScan out = scan_from_row(s);
+    exec("COMMIT");
+    return out;
   } catch (...) {
     exec("ROLLBACK");
     throw;

@@ -32,6 +32,14 @@ struct StoredMatch {
   double inlier_ratio = 0;
 };
 
+// The operator took the scan out of the map (DELETE /api/v1/scans/{id}): who, why, when. The
+// scan and its file stay; putting it back is recorded the same way.
+struct Exclusion {
+  std::string by;
+  std::string reason;
+  std::string at;  // UTC, ISO 8601 with milliseconds
+};
+
 struct StoredScan {
   std::int64_t id = 0;
   std::string robot;
@@ -39,9 +47,10 @@ struct StoredScan {
   Pose placed;     // where the map put the scan (after matching)
   std::int64_t stamp_ns = 0;
   std::size_t points = 0;
-  std::string file;                  // the scan's PLY, relative to the session directory
-  std::string received_at;           // UTC, ISO 8601
-  std::optional<StoredMatch> match;  // none for the first scan, with matching off, or not yet
+  std::string file;                   // the scan's PLY, relative to the session directory
+  std::string received_at;            // UTC, ISO 8601
+  std::optional<StoredMatch> match;   // none for the first scan, with matching off, or not yet
+  std::optional<Exclusion> excluded;  // set while the operator keeps it out of the map
 };
 
 // One row of the session's record of what happened (append_event).
@@ -95,6 +104,11 @@ class SessionStore {
   // correction, or the reported pose carried into the map frame when it was refused): both in
   // one transaction.
   void record_match(std::int64_t id, const StoredMatch& match, const Pose& placed);
+  // Takes scan `id` out of the map (`excluded`) or puts it back, recorded with who and why (the
+  // full history is kept; scans() carries the latest). Returns the scan as it now stands;
+  // nothing for an unknown id.
+  std::optional<StoredScan> set_excluded(std::int64_t id, bool excluded, const std::string& by,
+                                         const std::string& reason);
   std::vector<StoredScan> scans() const;
   // The newest `limit` events recorded with append_event, oldest first.
   std::vector<SessionEvent> events(std::size_t limit) const;

@@ -187,6 +187,29 @@ test('operator page: map, candidates, approval, growth by WebSocket chunk, recon
     assert.deepEqual(fullMapFetches(requests), []);
     assert.equal(await page.evaluate(() => window.scanplan.view.chunkCount), 3);
 
+    // 6. A bad scan taken out of the map and put back (issue 16): from a point of scan 2 clicked
+    // in the view (the button that click shows), confirmed with a reason; the map is rebuilt
+    // without it, the page drops its points and lists it; "Put back" brings it back.
+    await page.evaluate(() => {
+      const b = document.getElementById('exclude-scan');
+      b.dataset.scan = '2';
+      b.textContent = 'Take scan 2 out of the map…';
+      b.hidden = false;
+    });
+    await page.click('#exclude-scan');
+    await page.fill('#confirm-reason', 'ghost walls from a wrong match');
+    await page.click('#confirm-ok');
+    await waitForData(page, 'scan 2 out of the view', () => document.body.dataset.chunks === '2' &&
+      document.querySelector('#excluded-scans .excluded-scan[data-scan="2"]') !== null, null, 30000);
+    assert.match(await page.locator('#excluded-scans').innerText(), /scan 2 .*ghost walls from a wrong match/s);
+    assert.equal((await session()).scans, 2);
+    await screenshot(page, 'operator_page_scan_excluded.png');
+    await page.click('#excluded-scans .excluded-scan[data-scan="2"] button');
+    await page.click('#confirm-ok');
+    await waitForData(page, 'scan 2 back in the view', () => document.body.dataset.chunks === '3' &&
+      document.getElementById('excluded-scans').hidden, null, 30000);
+    assert.match(await page.locator('#log').innerText(), /took scan 2 out of the map: ghost walls/);
+
     assert.deepEqual(problems.foreignRequests, [], 'every asset comes from our server');
     assert.deepEqual(problems.pageErrors, [], 'uncaught page errors');
     assert.deepEqual(problems.consoleErrors.filter((m) => !/ERR_INTERNET_DISCONNECTED|Failed to load resource|WebSocket/.test(m)), [], 'console errors');

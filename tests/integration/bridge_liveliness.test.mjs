@@ -96,7 +96,7 @@ test('a bridge killed mid-scan is lost, its scan fails, and nothing reaches the 
   // Long enough for any straggling part to have been stored, were it accepted.
   await new Promise((r) => setTimeout(r, 3000));
   const scans = await (await stack.api('GET', '/api/v1/scans')).json();
-  assert.deepEqual(scans, { scans: [], pending: 0, not_in_map: [] });
+  assert.deepEqual(scans, { scans: [], pending: 0, excluded: [], not_in_map: [] });
   assert.equal((await session()).scans, 0);
   assert.ok(!events.some((e) => e.type === 'scan_received'), 'no scan was received');
 

@@ -218,6 +218,41 @@ test('a second server on the same session is refused', async () => {
   assert.equal((await session()).scans, 2, 'the first server is untouched');
 });
 
+test('the operator takes a scan out of the map and puts it back, and it is recorded', async () => {
+  const del = (id, body) => stack.api('DELETE', `/api/v1/scans/${id}`, body && { body: JSON.stringify(body) });
+  const viewer = await stack.api('DELETE', '/api/v1/scans/2', { auth: stack.viewerToken });
+  assert.equal(viewer.status, 403);
+  assert.equal((await del(99)).status, 404);
+  let r = await del(2, { by: 'Ann', reason: 'ghost walls\nfrom a wrong match' });
+  assert.equal(r.status, 200);
+  const out = await r.json();
+  assert.equal(out.excluded.by, 'operator Ann');
+  assert.equal(out.excluded.reason, 'ghost walls\nfrom a wrong match');
+  r = await del(2);
+  assert.equal(r.status, 409);
+  assert.equal((await errorOf(r)).code, 'already_excluded');
+  r = await del(1);
+  assert.equal(r.status, 409, 'the last scan in the map stays');
+  assert.equal((await errorOf(r)).code, 'last_scan');
+  const s = await stack.waitFor('the map without scan 2', async () => {
+    const j = await session();
+    return j.scans === 1 && j.rebuilding === null ? j : undefined;
+  });
+  assert.ok(s.points > 0);
+  const list = await (await stack.api('GET', '/api/v1/scans')).json();
+  assert.deepEqual(list.scans.map((x) => x.id), [1]);
+  assert.deepEqual(list.excluded.map((x) => x.id), [2]);
+  assert.equal((await stack.api('GET', '/api/v1/scans/2')).status, 200);
+  r = await stack.api('POST', '/api/v1/scans/2/restore', { body: JSON.stringify({ by: 'Eve' }) });
+  assert.equal(r.status, 200);
+  assert.equal((await r.json()).excluded, null);
+  await stack.waitFor('scan 2 back in the map', async () => ((await session()).scans === 2 ? true : undefined));
+  assert.equal((await stack.api('POST', '/api/v1/scans/2/restore')).status, 409);
+  // Out again, to be found out after the restart below.
+  assert.equal((await del(2, { reason: 'kept out' })).status, 200);
+  await stack.waitFor('scan 2 out again', async () => ((await session()).scans === 1 ? true : undefined));
+});
+
 test('after a restart a lost scan file is reported, not silently missing', async () => {
   await stack.stop({ keepDir: true });
   const scans = join(stack.dir, 'session', 'scans');
@@ -227,12 +262,16 @@ test('after a restart a lost scan file is reported, not silently missing', async
     const j = await session();
     return j.rebuilding === null ? j : undefined;
   });
-  assert.equal(s.scans, 1);
+  assert.equal(s.scans, 0, 'scan 1 is lost, scan 2 is kept out');
   assert.equal(s.scans_not_in_map.length, 1);
   assert.equal(s.scans_not_in_map[0].id, 1);
   assert.match(s.scans_not_in_map[0].reason, /scan_000001\.ply/);
   const list = await (await stack.api('GET', '/api/v1/scans')).json();
   assert.deepEqual(list.not_in_map.map((x) => x.id), [1]);
+  assert.deepEqual(list.excluded.map((x) => [x.id, x.excluded.reason]), [[2, 'kept out']]);
+  // Put back after the restart: read from its file.
+  assert.equal((await stack.api('POST', '/api/v1/scans/2/restore')).status, 200);
+  await stack.waitFor('scan 2 back from its file', async () => ((await session()).scans === 1 ? true : undefined));
 });
 
 test('scan files without their database are refused, not emptied', async () => {

@@ -27,6 +27,10 @@ function describe(e) {
       return `${e.robot} is back`;
     case 'scan_failed':
       return `scan by ${e.robot} failed${e.reason ? `: ${e.reason}` : ''}`;
+    case 'scan_excluded':
+      return `took scan ${e.scan} out of the map${e.reason ? `: ${e.reason}` : ''}`;
+    case 'scan_restored':
+      return `put scan ${e.scan} back into the map`;
     case 'goal':
       return `proposed custom point ${who} at (${f1(e.x)}, ${f1(e.y)}), F ${Math.round(e.f ?? 0)}`;
     default:

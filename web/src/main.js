@@ -7,6 +7,7 @@ import { AnnotationsPanel } from './annotations.js';
 import { apiFetch, getJson, getToken, initToken } from './api.js';
 import { CandidatesPanel } from './candidates.js';
 import { CoverageChart } from './chart.js';
+import { ExcludedScans } from './excluded_scans.js';
 import { EventStream, OP_MAP_CHUNK, eventsUrl } from './events.js';
 import { GoalPicker } from './goals.js';
 import { DecisionLog } from './log.js';
@@ -60,7 +61,18 @@ const chunks = new MapChunks({
     if (view) view.addChunk(c);
     render();
   },
+  onRemove: (id) => {
+    if (view) view.removeChunk(id);
+    render();
+  },
   onChange: () => render(),
+});
+const excluded = new ExcludedScans({
+  list: $('excluded-scans'),
+  onChange: () => soon(() => {
+    refreshSession();
+    refreshScans();
+  }),
 });
 
 const topView = new TopView($('top-canvas'), {
@@ -211,6 +223,8 @@ function applyRole(role) {
   goals.setRole(operator);
   mission.setRole(operator);
   annotations.setRole(operator);
+  excluded.setRole(operator);
+  if (!operator) $('exclude-scan').hidden = true;
   updateTools();
 }
 
@@ -266,6 +280,7 @@ async function refreshScans() {
   try {
     const answer = await getJson('/api/v1/scans', { timeoutMs: 15000 });
     state.scans = answer.scans || [];
+    excluded.set(answer.excluded);
     for (const s of state.scans) if (s.areas) chart.set(s.id, s.areas);
     markers?.setScans(state.scans);
     topView.setScans(state.scans);
@@ -403,6 +418,18 @@ function onEvent(e) {
     case 'match_done':
       mission.onMatchDone(e);
       break;
+    case 'scan_excluded':
+    case 'scan_restored':
+      log.add({ ...e, kind: e.type });
+      break;
+    case 'map_rebuilt':
+      soon(() => {
+        refreshSession();
+        refreshScans();
+        refreshLayer();
+        refreshCandidates();
+      });
+      break;
     case 'map_updated':
       mission.onMapUpdated(e);
       chart.set(e.scan, e);
@@ -485,6 +512,12 @@ function setTool(tool) {
   else setViewStatus('');
 }
 
+$('exclude-scan').addEventListener('click', (e) => {
+  const id = Number(e.currentTarget.dataset.scan);
+  e.currentTarget.hidden = true;
+  if (Number.isInteger(id) && id > 0) excluded.exclude(id);
+});
+
 if (view) {
   view.onClick = (e) => {
     if (state.tool === 'measure') {
@@ -495,8 +528,12 @@ if (view) {
       else annotations.openForm(hit.point, { x: e.clientX, y: e.clientY });
     } else {
       const hit = view.pick(e.clientX, e.clientY);
+      const out = $('exclude-scan');
+      out.hidden = !hit || state.role !== 'operator';
       if (hit) {
         const p = hit.point;
+        out.dataset.scan = String(hit.scan);
+        out.textContent = `Take scan ${hit.scan} out of the map…`;
         setViewStatus(`point (${p.x.toFixed(2)}, ${p.y.toFixed(2)}, ${p.z.toFixed(2)}) of scan ${hit.scan}`);
       }
     }

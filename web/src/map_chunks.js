@@ -11,11 +11,12 @@ export class MapChunks {
   /**
    * @param {{onChunk: (c: {id: number, count: number, positions: Float32Array,
    *   colors: Uint8Array|null, min: number[], max: number[]}) => void,
-   *   onChange: () => void}} handlers
+   *   onChange: () => void, onRemove?: (id: number) => void}} handlers
    */
-  constructor({ onChunk, onChange }) {
+  constructor({ onChunk, onChange, onRemove = () => {} }) {
     this.onChunk = onChunk;
     this.onChange = onChange;
+    this.onRemove = onRemove;
     this.held = new Set(); // scan ids in the view
     this.pending = new Set(); // being fetched or decoded
     this.failed = new Map(); // scan id -> message
@@ -104,9 +105,16 @@ export class MapChunks {
 
   /**
    * Fetches the chunks of the scans in `ids` (the session's scan ids, ascending) that the page
-   * does not hold, one scan at a time, oldest first. Calls made while one runs are merged.
+   * does not hold, one scan at a time, oldest first, and drops those it holds that are no
+   * longer in the map (a scan the operator took out). Calls made while one runs are merged.
    */
   async sync(ids) {
+    const wanted = new Set(ids);
+    for (const id of [...this.held]) {
+      if (wanted.has(id)) continue;
+      this.held.delete(id);
+      this.onRemove(id);
+    }
     if (this.syncing) {
       this.resyncWanted = ids;
       return;

@@ -199,6 +199,19 @@ TEST(EventText, DescribesEachEventType) {
             "1481 saturated)");
   EXPECT_EQ(d(R"({"type":"scan_received","scan":2,"robot":"robot1","points":150000})"),
             "scan 2 from robot1 stored: 150000 points");
+  EXPECT_EQ(d(R"({"type":"scan_received","scan":4,"robot":"r","points":9,
+                  "dropped":{"non_finite":1,"out_of_range":2,"mount":0,"saturated":0}})"),
+            "scan 4 from r stored: 9 points (dropped 1 not finite, 2 out of range, 0 on the mount, "
+            "0 saturated)");
+  EXPECT_EQ(d(R"({"type":"scan_rejected","robot":"r","reason":"the pose's x is 1e+07 m"})"),
+            "scan from r REFUSED: the pose's x is 1e+07 m");
+  EXPECT_EQ(d(R"({"type":"scan_excluded","scan":2,"by":"operator Ann","reason":"ghost walls"})"),
+            "scan 2 taken out of the map by operator Ann: ghost walls");
+  EXPECT_EQ(d(R"({"type":"scan_restored","scan":2,"by":"operator","reason":""})"),
+            "scan 2 put back into the map by operator");
+  EXPECT_EQ(d(R"({"type":"map_rebuilt","scans":3,"completed_m2":10.2,"low_resolution_m2":1,
+                 "unscanned_m2":2,"movable_m2":5})"),
+            "map rebuilt from 3 scans: completed 10 m2, movable 5 m2");
   EXPECT_EQ(d(R"({"type":"mission","kind":"approve","candidate":12,"robot":"robot1",
                  "command_id":4,"x":12.34,"y":-4.5,"yaw_deg":45,"by":"operator Alice"})"),
             "approved candidate 12 by operator Alice: robot1 drives to (12.3, -4.5) heading 45 "
