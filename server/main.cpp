@@ -137,6 +137,9 @@ void serve(http::ServerConfig config, int count, const http::Router& router,
 
 // The whole server: storage, the application, DDS and HTTP, wired and run until stopped.
 void run(const Options& o) {
+  // A file-size limit (RLIMIT_FSIZE) is a full disk by another name: a write beyond it must fail
+  // with EFBIG, which the session store reports, not kill the server with SIGXFSZ.
+  std::signal(SIGXFSZ, SIG_IGN);
   // Flags first: a mistyped --listen must not open (or create) a session.
   http::ServerConfig config = server_config(o);
   std::string operator_token = env_or_empty("SCANPLAN_OPERATOR_TOKEN");

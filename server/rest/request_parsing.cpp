@@ -97,6 +97,9 @@ json object_body(const Request& request, const char* shape) {
 }
 
 double number_in(const json& j, const char* key, double lo, double hi) {
+  if (!j.is_object() || !j.contains(key)) {
+    throw HttpError(400, "bad_request", std::string("'") + key + "' is required");
+  }
   const json& v = j.at(key);
   if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < lo ||
       v.get<double>() > hi) {

@@ -38,12 +38,15 @@ void write_durably(const std::filesystem::path& path, const std::string& bytes) 
     if (n <= 0) {
       const std::string why = std::strerror(errno);
       ::close(fd);
+      ::unlink(part.c_str());  // a full disk keeps no half file
       throw SessionStoreError("cannot write " + part.string() + ": " + why);
     }
     done += static_cast<std::size_t>(n);
   }
   if (::fsync(fd) != 0 || ::close(fd) != 0) {
-    throw SessionStoreError("cannot sync " + part.string() + ": " + std::strerror(errno));
+    const std::string why = std::strerror(errno);
+    ::unlink(part.c_str());
+    throw SessionStoreError("cannot sync " + part.string() + ": " + why);
   }
   std::filesystem::rename(part, path);
   const int dir = ::open(path.parent_path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);

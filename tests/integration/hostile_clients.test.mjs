@@ -287,3 +287,74 @@ test('scan files without their database are refused, not emptied', async () => {
   assert.ok(!existsSync(join(sessionDir, 'session.sqlite')));
   stack = undefined;
 });
+
+test('a full disk refuses new scans with 503 and loses none it acknowledged', async () => {
+  // A file-size limit of 400 kB (RLIMIT_FSIZE: no root needed) stands for a full disk: the
+  // session's database and scan files cannot grow past it.
+  const dir2 = mkdtempSync(join(tmpdir(), 'scanplan-full-'));
+  const sessionDir = join(dir2, 'session');
+  const token = 'f'.repeat(32);
+  const start = (limitKb) => {
+    const p = spawn('sh', ['-c', `${limitKb ? `ulimit -f ${limitKb}; ` : ''}exec "$0" "$@"`,
+      requireEnv('SCANPLAN_SERVER'), '--session', sessionDir, '--listen', '127.0.0.1:0',
+      '--domain', requireEnv('SCANPLAN_TEST_DOMAIN'), '--web', requireEnv('SCANPLAN_WEB_DIR')],
+    { env: { ...process.env, SCANPLAN_OPERATOR_TOKEN: token }, stdio: ['ignore', 'pipe', 'pipe'] });
+    p.log = '';
+    p.stdout.on('data', (c) => { p.log += c; });
+    p.stderr.on('data', (c) => { p.log += c; });
+    p.exited = new Promise((resolve) => p.on('exit', resolve));
+    return p;
+  };
+  const urlOf = async (p) => {
+    for (let i = 0; i < 150; i++) {
+      const m = p.log.match(/listening on (http:\/\/[0-9.:]+)\//);
+      if (m) return m[1];
+      await new Promise((r) => setTimeout(r, 100));
+    }
+    throw new Error(`the server did not start:\n${p.log}`);
+  };
+  const call = (url, method, path, body) =>
+    fetch(url + path, { method, headers: { Authorization: `Bearer ${token}` }, body });
+  let server = start(400);
+  try {
+    let url = await urlOf(server);
+    let acknowledged = 0;
+    let refused;
+    for (let i = 0; i < 40 && !refused; i++) {
+      const r = await call(url, 'POST', `/api/v1/scans?x=${i % 5}&y=0&z=0&yaw_deg=0`, roomPly());
+      if (r.status === 201) acknowledged++;
+      else refused = { status: r.status, error: (await r.json()).error };
+    }
+    assert.ok(refused, 'the limit was reached');
+    assert.ok(acknowledged >= 1);
+    assert.equal(refused.status, 503);
+    assert.equal(refused.error.code, 'storage_failed');
+    // Still serving, and every acknowledged scan joins the map.
+    let s;
+    for (let i = 0; i < 300; i++) {
+      s = await (await call(url, 'GET', '/api/v1/session')).json();
+      if (s.scans === acknowledged) break;
+      await new Promise((r) => setTimeout(r, 100));
+    }
+    assert.equal(s.scans, acknowledged);
+    assert.equal((await call(url, 'GET', '/api/v1/health')).status, 200);
+    server.kill('SIGTERM');
+    await server.exited;
+    // With room again, a restart brings back every scan that was acknowledged, and no other.
+    server = start(0);
+    url = await urlOf(server);
+    let back;
+    for (let i = 0; i < 100; i++) {
+      back = await (await call(url, 'GET', '/api/v1/session')).json();
+      if (back.rebuilding === null && back.scans === acknowledged) break;
+      await new Promise((r) => setTimeout(r, 100));
+    }
+    assert.equal(back.scans, acknowledged);
+    assert.deepEqual(back.scans_not_in_map, []);
+    assert.ok(!readdirSync(join(sessionDir, 'scans')).some((f) => f.endsWith('.part')), 'no half-written file');
+  } finally {
+    server.kill('SIGKILL');
+    await server.exited;
+    rmSync(dir2, { recursive: true, force: true });
+  }
+});
