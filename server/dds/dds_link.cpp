@@ -8,6 +8,7 @@
 
 #include "app/domain_json.hpp"
 #include "common/iso_time.hpp"
+#include "common/text_fields.hpp"
 #include "ros2_types.h"
 #include "scanplan.h"
 #include "scanplan/io/image_codec.hpp"
@@ -409,11 +410,21 @@ void DdsLink::take_samples() {
   take_scan_parts();
 }
 
+bool DdsLink::acceptable_robot_id(const std::string& robot) {
+  const auto why = robot_id_problem(robot, "robot_id");
+  if (!why) return true;
+  // A broken or hostile participant: its samples would put a name on every operator's screen
+  // and in the session that no robot can have (issue 16).
+  spdlog::warn("ignoring a sample for robot id '{}': {}", robot.substr(0, 64), *why);
+  return false;
+}
+
 void DdsLink::take_progress() {
   dds::take_all<scanplan_ScanProgress>(
       progress_reader_, [&](const scanplan_ScanProgress& p, const dds_sample_info_t& info) {
         if (from_lost_bridge(info)) return;
         const std::string robot = str(p.robot_id);
+        if (!acceptable_robot_id(robot)) return;
         // A progress state this server does not know counts as the robot saying it failed.
         const ScanState state = parse_scan_state(str(p.state)).value_or(ScanState::kFailed);
         {
@@ -435,6 +446,7 @@ void DdsLink::take_status() {
       status_reader_, [&](const scanplan_RobotStatus& s, const dds_sample_info_t& info) {
         if (from_lost_bridge(info)) return;
         const std::string robot = str(s.robot_id);
+        if (!acceptable_robot_id(robot)) return;
         // The status names the robot the writer's participant (the bridge) speaks for.
         bool known = false;
         {

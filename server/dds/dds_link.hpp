@@ -112,6 +112,8 @@ class DdsLink final : public RobotLink, public AnnotationPublisher {
 
   void loop();
   void take_samples();
+  // Whether a sample's robot id is one (robot_id_problem); logs and drops it if not.
+  static bool acceptable_robot_id(const std::string& robot);
   void take_progress();
   void take_status();
   // The four parts of scans, into the assembly.
