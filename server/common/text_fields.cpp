@@ -2,39 +2,12 @@
 
 #include <algorithm>
 
+#include "http/utf8.hpp"
+
 namespace scanplan {
 namespace {
 
 constexpr std::size_t kMaxRobotIdBytes = 64;
-
-// Length of the UTF-8 sequence starting at text[i], 0 when it is not a valid one (overlong
-// forms, surrogates and code points beyond U+10FFFF included).
-std::size_t utf8_length(std::string_view text, std::size_t i) {
-  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
-  const unsigned char c = byte(i);
-  if (c < 0x80) return 1;
-  std::size_t n = 0;
-  unsigned lo = 0x80, hi = 0xBF;
-  if (c >= 0xC2 && c <= 0xDF) {
-    n = 2;
-  } else if (c >= 0xE0 && c <= 0xEF) {
-    n = 3;
-    if (c == 0xE0) lo = 0xA0;
-    if (c == 0xED) hi = 0x9F;
-  } else if (c >= 0xF0 && c <= 0xF4) {
-    n = 4;
-    if (c == 0xF0) lo = 0x90;
-    if (c == 0xF4) hi = 0x8F;
-  } else {
-    return 0;
-  }
-  if (i + n > text.size()) return 0;
-  if (byte(i + 1) < lo || byte(i + 1) > hi) return 0;
-  for (std::size_t k = 2; k < n; ++k) {
-    if (byte(i + k) < 0x80 || byte(i + k) > 0xBF) return 0;
-  }
-  return n;
-}
 
 // 'field', built by appending (GCC 12 warns of a false overlap in "'" + string + "'").
 std::string quoted(std::string_view field) {
@@ -47,6 +20,23 @@ std::string quoted(std::string_view field) {
 }
 
 }  // namespace
+
+std::string cleaned_text(std::string_view text, std::size_t max_bytes) {
+  static constexpr std::string_view kReplacement = "\xEF\xBF\xBD";
+  std::string out;
+  for (std::size_t i = 0; i < text.size();) {
+    const std::size_t n = http::utf8_sequence_length(text, i);
+    std::string_view piece = n == 0 ? kReplacement : text.substr(i, n);
+    if (n == 1) {
+      const auto c = static_cast<unsigned char>(text[i]);
+      if ((c < 0x20 && c != '\n' && c != '\t') || c == 0x7F) piece = " ";
+    }
+    if (out.size() + piece.size() > max_bytes) break;
+    out += piece;
+    i += n == 0 ? 1 : n;
+  }
+  return out;
+}
 
 std::optional<std::string> robot_id_problem(std::string_view text, std::string_view field) {
   const bool allowed = std::all_of(text.begin(), text.end(), [](char c) {
@@ -66,7 +56,7 @@ std::optional<std::string> text_problem(std::string_view text, std::string_view 
            std::to_string(max_bytes);
   }
   for (std::size_t i = 0; i < text.size();) {
-    const std::size_t n = utf8_length(text, i);
+    const std::size_t n = http::utf8_sequence_length(text, i);
     if (n == 0) return name + " is not valid UTF-8";
     const auto c = static_cast<unsigned char>(text[i]);
     const bool control = n == 1 && (c < 0x20 || c == 0x7F);

@@ -21,4 +21,9 @@ enum class TextKind { kLine, kProse };
 std::optional<std::string> text_problem(std::string_view text, std::string_view field,
                                         std::size_t max_bytes, TextKind kind);
 
+// Text from a peer that is shown rather than refused (a robot's status message over DDS): control
+// characters but newline and tab become spaces, invalid UTF-8 becomes U+FFFD, and it is cut to
+// at most `max_bytes` on a character boundary.
+std::string cleaned_text(std::string_view text, std::size_t max_bytes);
+
 }  // namespace scanplan

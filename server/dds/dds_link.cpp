@@ -26,6 +26,9 @@ std::string str(const char* s) {
   return s ? s : "";
 }
 
+// A robot's message is a line or two on the operator's screen; more is cut (cleaned_text).
+constexpr std::size_t kMaxRobotMessageBytes = 1000;
+
 std::int64_t now_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
              std::chrono::system_clock::now().time_since_epoch())
@@ -435,7 +438,8 @@ void DdsLink::take_progress() {
             awaited_.erase(robot);  // failed: the robot said so itself
           }
         }
-        const RobotScanState scan{p.command_id, state, p.fraction, str(p.message)};
+        const RobotScanState scan{p.command_id, state, p.fraction,
+                                  cleaned_text(str(p.message), kMaxRobotMessageBytes)};
         robots_.set_scan_state(robot, scan);
         events_.publish("scan_progress", scan_progress_json(robot, scan));
       });
@@ -466,8 +470,8 @@ void DdsLink::take_status() {
         pose.y = s.y;
         pose.z = s.z;
         pose.yaw = deg2rad(s.yaw_deg);
-        const RobotStatus status{s.command_id, parse_robot_activity(str(s.state)), str(s.message),
-                                 pose};
+        const RobotStatus status{s.command_id, parse_robot_activity(str(s.state)),
+                                 cleaned_text(str(s.message), kMaxRobotMessageBytes), pose};
         robots_.set_status(robot, status);
         // The once-a-second idle heartbeat is not news.
         if (status.state != RobotActivity::kIdle || status.command_id != 0) {

@@ -44,5 +44,12 @@ TEST(TextFields, InvalidUtf8AndOverlongTextAreRefused) {
   EXPECT_EQ(*why, "'reason' is too long: 5000000 bytes, at most 2000");
 }
 
+TEST(TextFields, PeerTextIsCleanedAndCutOnACharacterBoundary) {
+  EXPECT_EQ(cleaned_text("arrived\x1b[2J at goal\n\tok", 100), "arrived [2J at goal\n\tok");
+  EXPECT_EQ(cleaned_text(std::string("bad \xff byte"), 100), "bad \xEF\xBF\xBD byte");
+  EXPECT_EQ(cleaned_text("Żółw", 4), "Żó");  // 2 + 2 bytes; the third letter would split
+  EXPECT_EQ(cleaned_text(std::string(5000, 'a'), 1000).size(), 1000u);
+}
+
 }  // namespace
 }  // namespace scanplan
