@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace scanplan::server {
 
@@ -49,7 +50,7 @@ void ScanIntake::start() {
         problem = "its stored pose is not a place: " + *why;
       } else {
         try {
-          process(s, session_.load_points(s));
+          process(s, load(s));
         } catch (const std::exception& e) {
           problem = e.what();
         }
@@ -217,6 +218,19 @@ StoredScan ScanIntake::set_excluded(std::int64_t id, bool excluded, const std::s
   return *after;
 }
 
+PointCloud ScanIntake::load(const StoredScan& scan) const {
+  PointCloud cloud = session_.load_points(scan);
+  // A session written before points were checked on the way in may hold a point at 1e30 that
+  // would spread the map over the world again at every restart: the unmeasurable ones go here
+  // too (the mount and a saturation shell were dropped before the scan was stored).
+  ReturnFilterConfig unmeasurable;
+  unmeasurable.mount_radius_m = 0;
+  unmeasurable.min_saturated_points = std::numeric_limits<std::size_t>::max();
+  unmeasurable.sensor = Eigen::Vector3f(0, 0, static_cast<float>(live_.sensor_height_m()));
+  drop_bad_returns(cloud, unmeasurable);
+  return cloud;
+}
+
 std::vector<StoredScan> ScanIntake::excluded_scans() const {
   std::vector<StoredScan> out = session_.scans();
   std::erase_if(out, [](const StoredScan& s) { return !s.excluded; });
@@ -245,7 +259,7 @@ void ScanIntake::rebuild_map() {
   std::vector<PlanRecord> plans;
   try {
     plans = live_.rebuild(
-        keep, [this](const StoredScan& s) { return session_.load_points(s); },
+        keep, [this](const StoredScan& s) { return load(s); },
         [this](std::size_t done) {
           std::lock_guard lock(mutex_);
           if (rebuild_) rebuild_->done = done;

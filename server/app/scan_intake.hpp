@@ -127,6 +127,8 @@ class ScanIntake {
   };
   std::deque<Job> queue_;
   void rebuild_map();
+  // A stored scan's points, without any that cannot be a measurement.
+  PointCloud load(const StoredScan& scan) const;
   bool stop_ = false;
   std::vector<NotInMap> not_in_map_;
   std::optional<Rebuild> rebuild_;

@@ -5,7 +5,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
 import { connect } from 'node:net';
-import { existsSync, mkdtempSync, readdirSync, rmSync } from 'node:fs';
+import { existsSync, mkdtempSync, readdirSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { createRequire } from 'node:module';
@@ -286,6 +286,8 @@ test('after a restart a lost scan file is reported, not silently missing', async
   await stack.stop({ keepDir: true });
   const scans = join(stack.dir, 'session', 'scans');
   rmSync(join(scans, 'scan_000001.ply'));
+  // Scan 2's file as a session from before points were checked may hold it: a point at 1e30.
+  writeFileSync(join(scans, 'scan_000002.ply'), roomPly([[1e30, 0, 0]]));
   stack = await startStack({ bridge: false, dir: stack.dir });
   const s = await stack.waitFor('the session rebuilt', async () => {
     const j = await session();
@@ -300,7 +302,13 @@ test('after a restart a lost scan file is reported, not silently missing', async
   assert.equal(list.excluded.find((x) => x.id === 2).excluded.reason, 'kept out');
   // Put back after the restart: read from its file.
   assert.equal((await stack.api('POST', '/api/v1/scans/2/restore')).status, 200);
-  await stack.waitFor('scan 2 back from its file', async () => ((await session()).scans === 1 ? true : undefined));
+  const back = await stack.waitFor('scan 2 back from its file', async () => {
+    const j = await session();
+    return j.scans === 1 ? j : undefined;
+  });
+  for (const v of [...back.bounds.min, ...back.bounds.max]) {
+    assert.ok(Math.abs(v) < 30, `the point at 1e30 stays out: bounds ${JSON.stringify(back.bounds)}`);
+  }
 });
 
 test('scan files without their database are refused, not emptied', async () => {
