@@ -190,7 +190,8 @@ std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> LiveMap:
   return layers;
 }
 
-std::vector<PlanRecord> LiveMap::refresh_derived(const std::function<void()>& commit) {
+std::vector<PlanRecord> LiveMap::refresh_derived(const std::function<void()>& commit,
+                                                 bool scan_joined) {
   if (!mission_.has_map()) {
     std::lock_guard lock(mutex_);
     if (commit) commit();
@@ -209,8 +210,8 @@ std::vector<PlanRecord> LiveMap::refresh_derived(const std::function<void()>& co
     layers_ = std::move(layers);
     layer_geometry_ = geometry_of(regions);
     areas_ = areas;
-    // A commit means a scan joined (set_params re-segments without one).
-    if (commit) areas_after_[last_scan_.first] = areas;
+    // Only a joining scan has areas "after" it (set_params and rebuild re-segment without one).
+    if (commit && scan_joined) areas_after_[last_scan_.first] = areas;
   }
   return records;
 }
@@ -356,9 +357,24 @@ Bounds3 LiveMap::bounds() const {
   return bounds_;
 }
 
-std::vector<PlanRecord> LiveMap::rebuild(const std::vector<StoredScan>& keep,
-                                         const ScanLoader& load,
-                                         const std::function<void(std::size_t)>& progress) {
+namespace {
+
+// A scan's map-frame points carried back into its own frame (the pipeline takes scans so).
+PointCloud in_own_frame(const PointCloud& in_map, const Pose& placed) {
+  const Eigen::Affine3f scan_from_map = placed.isometry().inverse().cast<float>();
+  PointCloud own;
+  own.reserve(in_map.size());
+  for (std::size_t i = 0; i < in_map.size(); ++i) {
+    own.push_back(scan_from_map * in_map.points[i], in_map.colors[i]);
+  }
+  return own;
+}
+
+}  // namespace
+
+LiveMap::Rebuilt LiveMap::rebuild(const std::vector<StoredScan>& keep, const ScanLoader& load,
+                                  const std::function<void(std::size_t)>& progress) {
+  Rebuilt out;
   std::lock_guard encode_lock(encode_mutex_);
   std::map<std::int64_t,
            std::pair<std::shared_ptr<const PointCloud>, std::shared_ptr<const std::string>>>
@@ -385,18 +401,19 @@ std::vector<PlanRecord> LiveMap::rebuild(const std::vector<StoredScan>& keep,
   std::size_t count = 0;
   for (const StoredScan& s : keep) {
     auto [in_map, chunk] = held.count(s.id) ? held[s.id] : decltype(held)::mapped_type{};
-    if (!in_map) in_map = MissionPipeline::to_map_frame(load(s), s.placed);
+    if (!in_map) {
+      try {
+        in_map = MissionPipeline::to_map_frame(load(s), s.placed);
+      } catch (const std::exception& e) {
+        out.skipped.push_back({s, e.what()});  // its file is gone or damaged: the rest go on
+        continue;
+      }
+    }
     if (!chunk && !in_map->empty()) {
       chunk = std::make_shared<const std::string>(encode_draco(*in_map));
     }
-    // The pipeline wants the scan in its own frame: the map-frame points carried back.
-    const Eigen::Affine3f scan_from_map = s.placed.isometry().inverse().cast<float>();
-    PointCloud own;
-    own.reserve(in_map->size());
-    for (std::size_t i = 0; i < in_map->size(); ++i) {
-      own.push_back(scan_from_map * in_map->points[i], in_map->colors[i]);
-    }
-    fresh.add(own, {s.estimated, s.placed, s.match && s.match->applied}, in_map);
+    fresh.add(in_own_frame(*in_map, s.placed), {s.estimated, s.placed, s.match && s.match->applied},
+              in_map);
     thinned.add(*in_map);
     const Bounds3 b = bounds_of(*in_map);
     if (b.valid()) {
@@ -414,20 +431,22 @@ std::vector<PlanRecord> LiveMap::rebuild(const std::vector<StoredScan>& keep,
   thinned_ = std::move(thinned);
   // Where each robot last scanned stays where it is: the robot has not moved.
   for (const auto& [robot, pose] : pose_of) scan_pose_of_.try_emplace(robot, pose);
-  const auto plans = refresh_derived([&] {
-    scans_ = std::move(scans);
-    placed_ = std::move(placed);
-    chunks_ = std::move(chunks);
-    point_count_ = count;
-    bounds_ = bounds;
-    ++generation_;
-  });
+  out.plans = refresh_derived(
+      [&] {
+        scans_ = std::move(scans);
+        placed_ = std::move(placed);
+        chunks_ = std::move(chunks);
+        point_count_ = count;
+        bounds_ = bounds;
+        ++generation_;
+      },
+      /*scan_joined=*/false);
   encode_wanted_.notify_one();
   if (on_map) on_map(thinned_.cloud());
   if (on_plan) {
-    for (const PlanRecord& plan : plans) on_plan(plan);
+    for (const PlanRecord& plan : out.plans) on_plan(plan);
   }
-  return plans;
+  return out;
 }
 
 LiveMap::EncodedMap LiveMap::encoded_map(std::chrono::milliseconds wait) const {

@@ -94,10 +94,14 @@ class LiveMap {
   // The map made anew from `keep` (stored scans, in id order, at their placed poses): after the
   // operator took a scan out or put one back. Points of scans the map holds are reused; the
   // others come from `load` (the scan in its own frame). `progress` is told how many are in.
-  // Returns the new plans, as add() does.
+  // A scan `load` cannot give (its file gone or damaged) is left out and named in `skipped`.
   using ScanLoader = std::function<PointCloud(const StoredScan&)>;
-  std::vector<PlanRecord> rebuild(const std::vector<StoredScan>& keep, const ScanLoader& load,
-                                  const std::function<void(std::size_t)>& progress = {});
+  struct Rebuilt {
+    std::vector<PlanRecord> plans;                            // as add() returns them
+    std::vector<std::pair<StoredScan, std::string>> skipped;  // with why
+  };
+  Rebuilt rebuild(const std::vector<StoredScan>& keep, const ScanLoader& load,
+                  const std::function<void(std::size_t)>& progress = {});
 
   std::vector<StoredScan> scans() const;
   // Where a new scan goes: matched against the map so far (MissionPipeline::place). Nothing when
@@ -183,7 +187,9 @@ class LiveMap {
   // Recomputes layers, areas and the plans from the pipeline and publishes them together with
   // whatever `commit` changes (run under mutex_); needs encode_mutex_ held. Returns the new
   // plans, that of the robot whose scan came last last (none when there is no map to plan on).
-  std::vector<PlanRecord> refresh_derived(const std::function<void()>& commit);
+  // `scan_joined`: the commit brings a new scan, whose areas after it are kept (areas_after).
+  std::vector<PlanRecord> refresh_derived(const std::function<void()>& commit,
+                                          bool scan_joined = true);
   // One plan per robot not driving to a goal, the driving robots' goals claimed first; that of
   // the robot whose scan came last last. Needs encode_mutex_ held.
   std::vector<PlanRecord> make_plans() const;

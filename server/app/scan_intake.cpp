@@ -258,12 +258,18 @@ void ScanIntake::rebuild_map() {
   }
   std::vector<PlanRecord> plans;
   try {
-    plans = live_.rebuild(
+    LiveMap::Rebuilt rebuilt = live_.rebuild(
         keep, [this](const StoredScan& s) { return load(s); },
         [this](std::size_t done) {
           std::lock_guard lock(mutex_);
           if (rebuild_) rebuild_->done = done;
         });
+    plans = std::move(rebuilt.plans);
+    std::lock_guard lock(mutex_);
+    for (const auto& [scan, why] : rebuilt.skipped) {
+      spdlog::error("scan {} cannot be brought back into the map: {}", scan.id, why);
+      not_in_map_.push_back({scan.id, scan.robot, why});
+    }
   } catch (const std::exception& e) {
     spdlog::error("the map could not be rebuilt: {}", e.what());
   }
