@@ -95,10 +95,18 @@ test('acknowledged scans survive SIGKILL', async () => {
   await stack.stop({ keepDir: true, signal: 'SIGKILL' });
 
   stack = await startStack({ bridge: false, dir: sessionDir, tokens });
+  // Never an empty session while it comes back (issue 16): until all three scans are in, the
+  // session says it is rebuilding and how far it is.
+  const polls = [];
   const after = await stack.waitFor('the map rebuilt from disk', async () => {
     const s = await (await stack.api('GET', '/api/v1/session')).json();
-    return s.scans === 3 ? s : undefined;
+    polls.push({ scans: s.scans, rebuilding: s.rebuilding });
+    return s.scans === 3 && s.rebuilding === null ? s : undefined;
   });
+  for (const p of polls.filter((x) => x.scans < 3)) {
+    assert.equal(p.rebuilding?.total, 3, `rebuilding said while ${p.scans} of 3 were back`);
+    assert.ok(p.rebuilding.done <= 3);
+  }
   assert.equal(after.points, before.points);
   assert.deepEqual(after.bounds, before.bounds);
   const list = (await (await stack.api('GET', '/api/v1/scans')).json()).scans;
