@@ -238,6 +238,12 @@ SessionStore::~SessionStore() {
   sqlite3_close(db_);
 }
 
+void SessionStore::rollback() const {
+  // SQLite may have rolled the transaction back itself (a full disk: SQLITE_FULL); a second
+  // rollback would then fail and hide the error that matters.
+  if (sqlite3_get_autocommit(db_) == 0) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+}
+
 void SessionStore::exec(const char* sql) const {
   char* err = nullptr;
   if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
@@ -312,7 +318,7 @@ StoredScan SessionStore::add_scan(const std::string& robot, const Pose& estimate
     exec("COMMIT");
     return r;
   } catch (...) {
-    exec("ROLLBACK");
+    rollback();
     throw;
   }
 }
@@ -334,7 +340,7 @@ void SessionStore::record_match(std::int64_t id, const StoredMatch& m, const Pos
     s.step();
     exec("COMMIT");
   } catch (...) {
-    exec("ROLLBACK");
+    rollback();
     throw;
   }
 }
@@ -350,7 +356,7 @@ std::optional<StoredScan> SessionStore::set_excluded(std::int64_t id, bool exclu
       known.bind(1, id);
       known.step();
       if (known.integer(0) == 0) {
-        exec("ROLLBACK");
+        rollback();
         return std::nullopt;
       }
     }
@@ -365,7 +371,7 @@ std::optional<StoredScan> SessionStore::set_excluded(std::int64_t id, bool exclu
     exec("COMMIT");
     return out;
   } catch (...) {
-    exec("ROLLBACK");
+    rollback();
     throw;
   }
 }

@@ -132,6 +132,8 @@ class SessionStore {
 
  private:
   void exec(const char* sql) const;
+  // Ends a failed transaction, if SQLite has not already; never throws.
+  void rollback() const;
   // Removes unfinished writes and sets aside PLYs without a row (see the class comment).
   void tidy_scan_files() const;
 

@@ -375,6 +375,9 @@ test('a full disk refuses new scans with 503 and loses none it acknowledged', as
       await new Promise((r) => setTimeout(r, 100));
     }
     assert.equal(s.scans, acknowledged);
+    // Before the limit refused a scan, it refused matches' poses: those scans stayed in the map,
+    // and the session says why, with the database's own reason.
+    assert.match(s.storage_failure?.message ?? '', /could not be recorded in the session: .*(full|disk|large)/i);
     assert.equal((await call(url, 'GET', '/api/v1/health')).status, 200);
     server.kill('SIGTERM');
     await server.exited;
