@@ -461,7 +461,7 @@ bool HttpServer::admit(Connection& conn) {
     refusal = Response::error(500, "internal", "internal error while checking the request");
   }
   if (!refusal) return true;
-  queue(conn, *refusal, /*keep_alive=*/false, conn.parser.head().method == "HEAD");
+  queue(conn, std::move(*refusal), /*keep_alive=*/false, conn.parser.head().method == "HEAD");
   ++conn.queued_responses;
   conn.closing = true;
   return false;
@@ -506,19 +506,18 @@ void HttpServer::respond(Connection& conn, Request request) {
   if (keep_alive && request.version_minor == 0 && !response.header("Connection")) {
     response.set_header("Connection", "keep-alive");
   }
-  queue(conn, response, keep_alive, request.method == "HEAD");
+  queue(conn, std::move(response), keep_alive, request.method == "HEAD");
   ++conn.queued_responses;
   if (!keep_alive) conn.closing = true;
 }
 
-void HttpServer::queue(Connection& conn, const Response& response, bool keep_alive,
-                       bool head_request) {
+void HttpServer::queue(Connection& conn, Response response, bool keep_alive, bool head_request) {
   conn.out.append(serialize_head(response, keep_alive));
   if (!sends_body(response, head_request)) return;
   if (response.shared_owner) {
     conn.out.append_shared(response.shared_owner, response.shared_body);
   } else {
-    conn.out.append(response.body);
+    conn.out.append(std::move(response.body));
   }
 }
 

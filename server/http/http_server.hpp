@@ -87,8 +87,8 @@ class HttpServer {
   void discard_input(Connection& conn);
   void process(Connection& conn, Clock::time_point now);
   void respond(Connection& conn, Request request);
-  // Queues `response` on the connection (its head, then its body, shared or owned).
-  void queue(Connection& conn, const Response& response, bool keep_alive, bool head_request);
+  // Queues `response` on the connection (its head, then its body: shared, or moved in).
+  void queue(Connection& conn, Response response, bool keep_alive, bool head_request);
   // Whether the current request's head passes ServerConfig::admit; if not, queues the refusal.
   bool admit(Connection& conn);
   Response call_handler(const Request& request);

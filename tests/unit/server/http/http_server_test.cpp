@@ -577,22 +577,32 @@ TEST_F(HttpServerTest, ABodyAtTheMinimumRateIsReceived) {
   EXPECT_EQ(r->status, 201);
 }
 
+// Two clients a server limited to two connections serves, and what a third one is told.
+struct ThirdConnection {
+  std::unique_ptr<Client> a, b, c;
+  ClientResponse refusal;
+};
+ThirdConnection third_connection(std::uint16_t port) {
+  ThirdConnection t{std::make_unique<Client>(port), std::make_unique<Client>(port), nullptr, {}};
+  EXPECT_EQ(t.a->request("GET", "/api/v1/health").status, 200);
+  EXPECT_EQ(t.b->request("GET", "/api/v1/health").status, 200);
+  t.c = std::make_unique<Client>(port);
+  const auto r = t.c->read_response();
+  EXPECT_TRUE(r.has_value());
+  t.refusal = r.value_or(ClientResponse{});
+  return t;
+}
+
 TEST_F(HttpServerTest, OneAddressCannotTakeEveryConnection) {
   Limits limits;
   limits.max_connections_per_address = 2;
   start(limits);
-  Client a(port());
-  Client b(port());
-  EXPECT_EQ(a.request("GET", "/api/v1/health").status, 200);
-  EXPECT_EQ(b.request("GET", "/api/v1/health").status, 200);
-  Client c(port());
-  const auto r = c.read_response();
-  ASSERT_TRUE(r.has_value());
-  EXPECT_EQ(r->status, 503);
-  EXPECT_NE(r->json()["error"]["message"].get<std::string>().find("this address already holds 2"),
+  auto [a, b, c, r] = third_connection(port());
+  EXPECT_EQ(r.status, 503);
+  EXPECT_NE(r.json()["error"]["message"].get<std::string>().find("this address already holds 2"),
             std::string::npos);
-  b.close();
-  c.close();  // refused, it held its place until it went
+  b->close();
+  c->close();  // refused, it held its place until it went
   std::this_thread::sleep_for(100ms);
   Client d(port());
   EXPECT_EQ(d.request("GET", "/api/v1/health").status, 200)
@@ -665,17 +675,11 @@ TEST_F(HttpServerTest, ExcessConnectionsGet503) {
   Limits limits;
   limits.max_connections = 2;
   start(limits);
-  Client a(port());
-  Client b(port());
-  EXPECT_EQ(a.request("GET", "/api/v1/health").status, 200);
-  EXPECT_EQ(b.request("GET", "/api/v1/health").status, 200);
-  Client c(port());
-  const auto r = c.read_response();
-  ASSERT_TRUE(r.has_value());
-  EXPECT_EQ(r->status, 503);
-  EXPECT_EQ(r->json()["error"]["code"], "service_unavailable");
-  EXPECT_TRUE(c.closed_by_server());
-  EXPECT_EQ(a.request("GET", "/api/v1/health").status, 200) << "existing clients unaffected";
+  auto [a, b, c, r] = third_connection(port());
+  EXPECT_EQ(r.status, 503);
+  EXPECT_EQ(r.json()["error"]["code"], "service_unavailable");
+  EXPECT_TRUE(c->closed_by_server());
+  EXPECT_EQ(a->request("GET", "/api/v1/health").status, 200) << "existing clients unaffected";
 }
 
 TEST_F(HttpServerTest, SlowHeaderGets408) {
