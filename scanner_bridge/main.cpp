@@ -56,6 +56,12 @@ int main(int argc, char** argv) {
                         ->expected(3)
                         ->delimiter(',');
   start_opt->needs(world_opt);
+  std::string odometry;
+  app.add_option("--odometry", odometry,
+                 "drift|absolute: how the reported pose goes wrong (default: the world file's "
+                 "pose_noise.model, drift when it has none)")
+      ->check(CLI::IsMember({"drift", "absolute"}))
+      ->needs(world_opt);
   CLI11_PARSE(app, argc, argv);
   spdlog::set_default_logger(spdlog::stderr_color_mt("bridge"));
   if (world_file.empty() == replay_dir.empty()) {
@@ -82,6 +88,7 @@ int main(int argc, char** argv) {
           return 2;
         }
       }
+      if (!odometry.empty()) world.pose_noise.model = *scanplan::parse_odometry_model(odometry);
       scanplan::bridge::SimulatedRobot robot(std::move(world), participant, options);
       robot.run(g_stop);
     } else {

@@ -20,9 +20,7 @@ SimulatedRobot::SimulatedRobot(World world, dds::Participant& participant, Bridg
       commands_(participant, options_.robot_id),
       true_pose_(traversability_.standing_pose(world_.start.x, world_.start.y, world_.start.z,
                                                world_.start.yaw)),
-      pose_rng_(options_.seed) {
-  reported_ = reported_pose(true_pose_, world_.pose_noise, pose_rng_);
-}
+      odometry_(world_.pose_noise, true_pose_, options_.seed) {}
 
 bool SimulatedRobot::pass_time(double simulated_s, const std::atomic<bool>& stop) const {
   if (options_.time_scale <= 0) return !stop;
@@ -44,7 +42,7 @@ void SimulatedRobot::run(const std::atomic<bool>& stop) {
   while (!stop) {
     // A periodic idle status lets a server that started later learn where the robot is.
     if (std::chrono::steady_clock::now() - last_status > std::chrono::seconds(1)) {
-      publisher_.status(0, "idle", reported_);
+      publisher_.status(0, "idle", odometry_.reported());
       last_status = std::chrono::steady_clock::now();
     }
     for (const Command& c : commands_.wait(std::chrono::milliseconds(200))) {
@@ -54,12 +52,12 @@ void SimulatedRobot::run(const std::atomic<bool>& stop) {
       last_status = std::chrono::steady_clock::now();
     }
   }
-  publisher_.goodbye(reported_);
+  publisher_.goodbye(odometry_.reported());
 }
 
 void SimulatedRobot::scan(std::uint32_t command_id, const std::atomic<bool>& stop) {
   spdlog::info("scan command {}: scanning", command_id);
-  publisher_.status(command_id, "scanning", reported_);
+  publisher_.status(command_id, "scanning", odometry_.reported());
   publisher_.progress(command_id, "scanning", 0.0f);
   const ScannerConfig& cfg = world_.scanner;
   const auto started = std::chrono::steady_clock::now();
@@ -86,9 +84,9 @@ void SimulatedRobot::scan(std::uint32_t command_id, const std::atomic<bool>& sto
   }
   const PointCloud& cloud = simulated->cloud;
   CameraShot shot{encode_jpeg(simulated->panorama, cfg.camera_jpeg_quality), simulated->camera};
-  publisher_.scan(cloud, reported_, shot);
+  publisher_.scan(cloud, odometry_.reported(), shot);
   publisher_.progress(command_id, "done", 1.0f, std::to_string(cloud.size()) + " points");
-  publisher_.status(command_id, "idle", reported_);
+  publisher_.status(command_id, "idle", odometry_.reported());
   spdlog::info("scan command {}: published {} points and a {}-byte panorama", command_id,
                cloud.size(), shot.jpeg.size());
 }
@@ -97,7 +95,7 @@ void SimulatedRobot::move(const MoveRequest& goal, const std::atomic<bool>& stop
   const auto refuse = [&](const std::string& why) {
     spdlog::warn("move command {} to ({:.2f}, {:.2f}) refused: {}", goal.command_id, goal.x, goal.y,
                  why);
-    publisher_.status(goal.command_id, "refused", reported_, why);
+    publisher_.status(goal.command_id, "refused", odometry_.reported(), why);
   };
   if (!std::isfinite(goal.x) || !std::isfinite(goal.y) || !std::isfinite(goal.yaw_deg)) {
     return refuse("the goal is not a finite position");
@@ -113,12 +111,12 @@ void SimulatedRobot::move(const MoveRequest& goal, const std::atomic<bool>& stop
   const double distance = reach.distance_m[*goal_cell];
   spdlog::info("move command {}: driving {:.1f} m to ({:.2f}, {:.2f})", goal.command_id, distance,
                goal.x, goal.y);
-  publisher_.status(goal.command_id, "moving", reported_);
+  publisher_.status(goal.command_id, "moving", odometry_.reported());
   if (!pass_time(distance / options_.speed_mps, stop)) return;
   true_pose_ =
       traversability_.standing_pose(goal.x, goal.y, reach.z[*goal_cell], deg2rad(goal.yaw_deg));
-  reported_ = reported_pose(true_pose_, world_.pose_noise, pose_rng_);
-  publisher_.status(goal.command_id, "arrived", reported_,
+  odometry_.moved(true_pose_, distance);
+  publisher_.status(goal.command_id, "arrived", odometry_.reported(),
                     "drove " + std::to_string(static_cast<int>(std::lround(distance))) + " m");
 }
 

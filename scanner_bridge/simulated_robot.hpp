@@ -2,12 +2,12 @@
 
 #include <atomic>
 #include <cstdint>
-#include <random>
 #include <string>
 
 #include "command_reader.hpp"
 #include "scanner_publisher.hpp"
 #include "scanplan/sim/ray_caster.hpp"
+#include "scanplan/sim/simulated_odometry.hpp"
 #include "scanplan/sim/world.hpp"
 #include "scanplan/sim/world_traversability.hpp"
 
@@ -21,7 +21,8 @@ struct BridgeOptions {
 };
 
 // Stands for the scanner robot on DDS in a simulated world: scans where it truly stands
-// (publishing the pose it would report, true pose + noise), and drives to goals it can reach.
+// (publishing the pose it would report: SimulatedOdometry, drifting or absolute), and drives to
+// goals it can reach.
 class SimulatedRobot {
  public:
   SimulatedRobot(World world, dds::Participant& participant, BridgeOptions options);
@@ -41,8 +42,7 @@ class SimulatedRobot {
   ScannerPublisher publisher_;
   CommandReader commands_;
   Pose true_pose_;
-  Pose reported_;
-  std::mt19937_64 pose_rng_;
+  SimulatedOdometry odometry_;
   std::uint64_t scans_taken_ = 0;
 };
 

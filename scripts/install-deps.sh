@@ -6,7 +6,7 @@ packages=(
   build-essential cmake ccache pkg-config clang-format curl
   cyclonedds-dev cyclonedds-tools
   libeigen3-dev libdraco-dev libopencv-dev nlohmann-json3-dev libcli11-dev libspdlog-dev libssl-dev
-  libsqlite3-dev
+  libsqlite3-dev libceres-dev
   libgtest-dev libgmock-dev libbenchmark-dev libpcl-dev libnanoflann-dev
   nodejs npm chromium
 )

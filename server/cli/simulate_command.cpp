@@ -24,6 +24,8 @@ struct SimulateArgs {
   std::uint64_t seed = 1;
   std::string match = "on";
   std::string registrability = "on";
+  std::string odometry;  // empty: the world file's
+  std::string graph = "on";
   RegistrabilityConfig forecast;
 };
 
@@ -46,6 +48,7 @@ ClosedLoopConfig config_of(const SimulateArgs& a) {
   config.max_scans = a.max_scans;
   config.seed = a.seed;
   if (a.match == "off") config.matching.reset();
+  if (a.graph == "off") config.graph.reset();
   config.planner.registrability = a.forecast;
   config.planner.registrability.enabled = a.registrability == "on";
   return config;
@@ -105,25 +108,46 @@ nlohmann::json scan_json(const LoopStep& s, const LoopStep& first, const LoopSte
     if (s.match_proposed) match["proposed"] = pose_json(*s.match_proposed);
     match["prior"] = pose_json(s.prior_pose);
   }
+  // "placed" is where the map has the scan at the end (the graph's last estimate); "matched"
+  // where matching alone put it, "joined" where the map had it right after it came.
   return {{"scan", s.scan},
           {"reported", pose_json(s.reported_pose)},
-          {"placed", pose_json(s.placed_pose)},
+          {"matched", pose_json(s.matched_pose)},
+          {"joined", pose_json(s.placed_pose)},
+          {"placed", pose_json(s.final_pose)},
           {"true", pose_json(true_in_map(first.placed_pose, first.true_pose, s.true_pose))},
-          {"placed_error_m", s.placed_error_m},
-          {"placed_error_deg", s.placed_error_deg},
+          {"placed_error_m", s.final_error_m},
+          {"placed_error_deg", s.final_error_deg},
+          {"matched_error_m", s.matched_error_m},
+          {"matched_error_deg", s.matched_error_deg},
+          {"joined_error_m", s.placed_error_m},
+          {"joined_error_deg", s.placed_error_deg},
           {"match", match},
+          {"graph",
+           {{"pairs_tried", s.pairs_tried},
+            {"pairs_matched", s.pairs_matched},
+            {"rematches_tried", s.rematches_tried},
+            {"rematched", s.rematched},
+            {"ms", s.graph_ms},
+            {"solve_ms", s.solve_ms},
+            {"corrected_scans", s.corrected_scans},
+            {"corrected_max_m", s.corrected_max_m}}},
           {"forecast", forecast_json(previous)}};
 }
 
 // How the map's poses came out: matches tried and applied, and the placed error against the
-// truth relative to the first scan (median and worst over the scans after it).
+// truth relative to the first scan (median and worst over the scans after it), at the end and
+// from matching alone.
 nlohmann::json accuracy_of(const LoopResult& r) {
-  std::vector<double> metres, degrees;
+  std::vector<double> metres, degrees, matched_m, matched_deg, solve_ms;
   int tried = 0, applied = 0;
   for (std::size_t k = 1; k < r.steps.size(); ++k) {
     const LoopStep& s = r.steps[k];
-    metres.push_back(s.placed_error_m);
-    degrees.push_back(s.placed_error_deg);
+    metres.push_back(s.final_error_m);
+    degrees.push_back(s.final_error_deg);
+    matched_m.push_back(s.matched_error_m);
+    matched_deg.push_back(s.matched_error_deg);
+    solve_ms.push_back(s.solve_ms);
     tried += s.match.has_value();
     applied += s.match_applied;
   }
@@ -142,7 +166,28 @@ nlohmann::json accuracy_of(const LoopResult& r) {
           {"placed_error_median_m", median(metres)},
           {"placed_error_median_deg", median(degrees)},
           {"placed_error_max_m", worst(metres)},
-          {"placed_error_max_deg", worst(degrees)}};
+          {"placed_error_max_deg", worst(degrees)},
+          {"matched_error_median_m", median(matched_m)},
+          {"matched_error_median_deg", median(matched_deg)},
+          {"matched_error_max_m", worst(matched_m)},
+          {"matched_error_max_deg", worst(matched_deg)},
+          {"solve_ms_median", median(solve_ms)},
+          {"solve_ms_max", worst(solve_ms)}};
+}
+
+// The pose graph's edges against the truth: which kinds of relation go wrong, and whether the
+// robust loss set the wrong ones aside (a large whitened error).
+nlohmann::json edges_json(const LoopResult& r) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const LoopEdge& e : r.edges) {
+    out.push_back({{"from", e.from + 1},
+                   {"to", e.to + 1},
+                   {"origin", e.origin},
+                   {"error_m", e.error_m},
+                   {"error_deg", e.error_deg},
+                   {"whitened", e.whitened}});
+  }
+  return out;
 }
 
 nlohmann::json summary_of(const SimulateArgs& a, const World& world, const ClosedLoopConfig& config,
@@ -167,6 +212,8 @@ nlohmann::json summary_of(const SimulateArgs& a, const World& world, const Close
           {"alpha", a.alpha},
           {"seed", a.seed},
           {"match", a.match},
+          {"graph", a.graph},
+          {"odometry", odometry_model_name(world.pose_noise.model)},
           {"registrability", a.registrability},
           {"scans", scans},
           {"detected_m2", last.detected_m2},
@@ -180,24 +227,27 @@ nlohmann::json summary_of(const SimulateArgs& a, const World& world, const Close
           {"stopped", r.stopped_because},
           {"accuracy", accuracy_of(r)},
           {"true_poses", true_poses},
+          {"edges", edges_json(r)},
           {"out", a.out}};
 }
 
 void run_simulate(const SimulateArgs& a) {
   const ClosedLoopConfig config = config_of(a);
-  const World world = load_world(a.world);
+  World world = load_world(a.world);
+  if (!a.odometry.empty()) world.pose_noise.model = *parse_odometry_model(a.odometry);
   const std::filesystem::path out(a.out);
   std::filesystem::create_directories(out);
 
   std::ofstream csv(out / "coverage.csv");
   if (!csv) throw std::runtime_error("cannot write " + (out / "coverage.csv").string());
   csv << "scan,x,y,detected_m2,completed_m2,coverage_pct,path_m,plan_ms,placed_error_m,"
-         "placed_error_deg\n";
+         "placed_error_deg,matched_error_m,matched_error_deg\n";
   const auto on_step = [&](const LoopStep& s, const MappingPipeline& pipeline) {
     char row[256];
-    std::snprintf(row, sizeof row, "%d,%.3f,%.3f,%.1f,%.1f,%.2f,%.2f,%.1f,%.4f,%.3f\n", s.scan,
-                  s.true_pose.x, s.true_pose.y, s.detected_m2, s.completed_m2, s.coverage_pct,
-                  s.path_m, s.plan_ms, s.placed_error_m, s.placed_error_deg);
+    std::snprintf(row, sizeof row, "%d,%.3f,%.3f,%.1f,%.1f,%.2f,%.2f,%.1f,%.4f,%.3f,%.4f,%.3f\n",
+                  s.scan, s.true_pose.x, s.true_pose.y, s.detected_m2, s.completed_m2,
+                  s.coverage_pct, s.path_m, s.plan_ms, s.placed_error_m, s.placed_error_deg,
+                  s.matched_error_m, s.matched_error_deg);
     csv << row << std::flush;
     cv::Mat img = render_regions(*pipeline.regions(), &*pipeline.movable(), pipeline.scan_points());
     draw_plan(img, *pipeline.regions(), s.candidates, s.chosen);
@@ -209,6 +259,10 @@ void run_simulate(const SimulateArgs& a) {
     if (s.match) {
       std::cerr << ", match " << (s.match_applied ? "applied" : "not applied") << ", placed "
                 << s.placed_error_m << " m / " << s.placed_error_deg << "° from the truth";
+      if (s.pairs_tried) {
+        std::cerr << ", graph: " << s.pairs_matched << "/" << s.pairs_tried << " pairs, "
+                  << s.corrected_scans << " scans moved (up to " << s.corrected_max_m << " m)";
+      }
     }
     std::cerr << "\n";
   };
@@ -233,6 +287,14 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--max-scans", args->max_scans, "scans at most")->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed for noise and the planner")->capture_default_str();
   cmd->add_option("--match", args->match, "scan matching of each scan against the map (on|off)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"on", "off"}));
+  cmd->add_option("--odometry", args->odometry,
+                  "drift|absolute: how the reported pose goes wrong (default: the world file's "
+                  "pose_noise.model, drift when it has none)")
+      ->check(CLI::IsMember({"drift", "absolute"}));
+  cmd->add_option("--graph", args->graph,
+                  "the pose graph over the scans, optimised after each (on|off; needs --match on)")
       ->capture_default_str()
       ->check(CLI::IsMember({"on", "off"}));
   cmd->add_option("--registrability", args->registrability,

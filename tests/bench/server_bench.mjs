@@ -25,7 +25,7 @@ const work = mkdtempSync(join(tmpdir(), 'scanplan-bench-'));
 // Exact poses there, so that the loop runs to SCANS scans rather than stopping where a map built
 // from noisy, unmatched poses leaves nothing movable.
 mkdirSync(join(work, 'exact'));
-const exact = worldVariant(join(work, 'exact'), 'campus.json', { pose_noise: { xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 } }).file;
+const exact = worldVariant(join(work, 'exact'), 'campus.json', { pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 } }).file;
 execFileSync(cli, ['simulate', '--world', exact, '--policy', 'paper', '--max-scans', String(scans),
   '--match', 'off', '--seed', '1', '--out', join(work, 'sim')], { stdio: ['ignore', 'ignore', 'ignore'] });
 const poses = JSON.parse(readFileSync(join(work, 'sim', 'summary.json'), 'utf8')).true_poses;

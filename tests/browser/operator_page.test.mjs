@@ -25,7 +25,7 @@ let stack;
 before(async () => {
   // No pose noise: the robot scans exactly where it was sent, so the test checks positions.
   const { file } = worldVariant(mkdtempSync(join(tmpdir(), 'scanplan-page-')), 'yard.json', {
-    pose_noise: { xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
+    pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
   });
   stack = await startStack({ world: file, timeScale: 600 });
   await scanAndWait(stack, 1);

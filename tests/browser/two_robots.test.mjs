@@ -13,7 +13,7 @@ import { dataset, frames, openPage, overflowing, screenshot, waitForData, withBr
 let stack;
 before(async () => {
   const { file } = worldVariant(mkdtempSync(join(tmpdir(), 'scanplan-two-')), 'yard.json', {
-    pose_noise: { xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
+    pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
   });
   // Slow enough that robot1 is still driving while the page is checked (a 30 m drive: 3 s).
   stack = await startStack({ world: file, timeScale: 20 });

@@ -11,7 +11,7 @@ import { startStack, scanAndWait, worldVariant } from '../support/stack.mjs';
 let stack;
 before(async () => {
   const { file } = worldVariant(mkdtempSync(join(tmpdir(), 'scanplan-approval-')), 'yard.json', {
-    pose_noise: { xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
+    pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
   });
   stack = await startStack({ world: file });
 });

@@ -47,7 +47,8 @@ class BridgeCommands : public ::testing::Test {
     // The yard with exact reported poses, so positions can be compared to the goals.
     nlohmann::json world;
     std::ifstream(SCANPLAN_SOURCE_DIR "/samples/worlds/yard.json") >> world;
-    world["pose_noise"] = {{"xy_sigma_m", 0}, {"z_sigma_m", 0}, {"yaw_sigma_deg", 0}};
+    world["pose_noise"] = {
+        {"model", "absolute"}, {"xy_sigma_m", 0}, {"z_sigma_m", 0}, {"yaw_sigma_deg", 0}};
     world["scanner"] = {{"rotation_step_deg", 1.0}, {"camera_width_px", 512}};
     world_file_ =
         new std::filesystem::path(std::filesystem::temp_directory_path() /

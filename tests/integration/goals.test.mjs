@@ -12,7 +12,7 @@ import { scanAndWait, startStack, worldVariant } from '../support/stack.mjs';
 let stack;
 before(async () => {
   const { file } = worldVariant(mkdtempSync(join(tmpdir(), 'scanplan-goals-')), 'yard.json', {
-    pose_noise: { xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
+    pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
   });
   stack = await startStack({ world: file });
 });

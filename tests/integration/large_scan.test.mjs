@@ -21,7 +21,7 @@ const room = {
   ],
   start: [0.3, -0.2, 10],
   scanner: { vertical_step_deg: 0.4, rotation_step_deg: 0.4 },
-  pose_noise: { xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
+  pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
 };
 // 180° / 0.4° + 1 beams per fan, 360° / 0.4° stage angles; none can miss inside the room.
 const expected = (180 / 0.4 + 1) * (360 / 0.4);

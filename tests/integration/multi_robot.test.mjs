@@ -17,7 +17,7 @@ let stack;
 let listener;
 before(async () => {
   const { file } = worldVariant(mkdtempSync(join(tmpdir(), 'scanplan-robots-')), 'yard.json', {
-    pose_noise: { xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
+    pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
   });
   // Slow enough (a 30 m drive takes 3 s) that robot1 is still driving when robot2 is approved.
   stack = await startStack({ world: file, timeScale: 20 });

@@ -20,7 +20,7 @@ before(async () => {
   // Exact reported poses, so the approved goal is reachable and the follow-up scan happens.
   worldDir = mkdtempSync(join(tmpdir(), 'scanplan-ros-wire-'));
   const { file } = worldVariant(worldDir, 'yard.json', {
-    pose_noise: { xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
+    pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
   });
   stack = await startStack({ world: file });
   early = await startListener(LISTENER);

@@ -42,7 +42,7 @@ before(async () => {
   const dir = mkdtempSync(join(tmpdir(), 'scanplan-world-'));
   // Exact reported poses, so the map's bounds are the yard's walls to within the range noise.
   const { file } = worldVariant(dir, 'yard.json', {
-    pose_noise: { xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
+    pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
   });
   stack = await startStack({ world: file });
 });

@@ -4,6 +4,7 @@
 #include <random>
 #include <set>
 
+#include "scanplan/sim/simulated_odometry.hpp"
 #include "scanplan/sim/simulated_scanner.hpp"
 #include "scanplan/sim/world_traversability.hpp"
 
@@ -62,6 +63,63 @@ std::optional<std::size_t> drive_to_best(const WorldTraversability& trav,
   return std::nullopt;
 }
 
+// The scan matched against the map and joined, the graph optimised: step's poses and match.
+void place(MissionPipeline& mission, const PointCloud& cloud, LoopStep& step) {
+  static const std::string kTrack = "robot";
+  step.prior_pose = mission.prior(step.reported_pose, kTrack);
+  step.matched_pose = step.prior_pose;
+  Placement where{step.reported_pose, step.prior_pose, false};
+  where.track = kTrack;
+  if (const auto m = mission.place(cloud, step.reported_pose, kTrack)) {
+    step.match = m->result;
+    step.match_applied = m->applied;
+    step.matched_pose = m->placed;
+    step.match_proposed = m->proposed;
+    where.placed = m->placed;
+    where.matched = m->applied;
+    where.information = m->information;
+  }
+  mission.add(cloud, where);
+  step.placed_pose = mission.poses().back();
+  if (const auto& c = mission.last_correction()) {
+    step.pairs_tried = c->graph.pairs_tried;
+    step.pairs_matched = c->graph.pairs_matched;
+    step.rematches_tried = c->graph.rematches_tried;
+    step.rematched = c->graph.rematched;
+    step.graph_ms = c->graph.match_ms + c->graph.solve.time_ms;
+    step.solve_ms = c->graph.solve.time_ms;
+    step.corrected_max_m = c->max_moved_m;
+    step.corrected_scans = c->moved.size();
+  }
+}
+
+// Where the graph had each scan when the mission ended, against the truth.
+void final_errors(const MissionPipeline& mission, LoopResult& result) {
+  if (result.steps.empty()) return;
+  const LoopStep& first = result.steps.front();
+  for (std::size_t k = 0; k < result.steps.size(); ++k) {
+    LoopStep& s = result.steps[k];
+    s.final_pose = mission.poses().at(k);
+    if (k == 0) continue;
+    const PoseError e = placed_error(first.placed_pose, first.true_pose, s.final_pose, s.true_pose);
+    s.final_error_m = e.metres;
+    s.final_error_deg = e.degrees;
+  }
+  const ScanGraph* graph = mission.graph();
+  if (!graph) return;
+  const auto truth = [&](std::size_t k) {
+    return true_in_map(first.placed_pose, first.true_pose, result.steps.at(k).true_pose);
+  };
+  for (std::size_t i = 0; i < graph->graph().edges().size(); ++i) {
+    const GraphEdge& e = graph->graph().edges()[i];
+    const RelativePose t = relative_pose(truth(e.from), truth(e.to));
+    result.edges.push_back({e.from, e.to, graph->edge_origin(i),
+                            std::hypot(e.measured.x - t.x, e.measured.y - t.y, e.measured.z - t.z),
+                            std::abs(rad2deg(std::remainder(e.measured.yaw - t.yaw, 2 * M_PI))),
+                            graph->graph().whitened_error(i)});
+  }
+}
+
 }  // namespace
 
 Pose true_in_map(const Pose& first_placed, const Pose& first_true, const Pose& truth) {
@@ -83,10 +141,8 @@ LoopResult run_closed_loop(
   const WorldTraversability trav(world, caster);
   Pose truth = trav.standing_pose(world.start.x, world.start.y, world.start.z, world.start.yaw);
 
-  MissionConfig mission_config{config.pipeline,
-                               config.planner,
-                               config.matching,
-                               {world.pose_noise.xy_sigma_m, world.pose_noise.yaw_sigma_deg}};
+  MissionConfig mission_config{config.pipeline, config.planner, config.matching, world.pose_noise,
+                               config.graph};
   mission_config.mapping.sensor_height_m = world.scanner.mount_height_m;
   MissionPipeline mission(mission_config);
   const MappingPipeline& pipeline = mission.mapping();
@@ -97,7 +153,7 @@ LoopResult run_closed_loop(
   std::vector<CellIndex> ground;
 
   LoopResult result;
-  std::mt19937_64 pose_rng(config.seed);
+  SimulatedOdometry odometry(world.pose_noise, truth, config.seed);
   double path_m = 0;
   for (int scan = 1; scan <= config.max_scans; ++scan) {
     LoopStep step;
@@ -105,8 +161,7 @@ LoopResult run_closed_loop(
     step.true_pose = truth;
     const PointCloud cloud = simulate_scan(caster, world.scanner, truth,
                                            config.seed * 7919 + static_cast<std::uint64_t>(scan));
-    step.reported_pose = reported_pose(truth, world.pose_noise, pose_rng);
-    step.placed_pose = step.reported_pose;
+    step.reported_pose = odometry.reported();
     if (scan == 1) {
       world_from_map = truth.isometry() * step.reported_pose.isometry().inverse();
       const Eigen::Isometry3d map_from_world = world_from_map.inverse();
@@ -119,25 +174,21 @@ LoopResult run_closed_loop(
       ground = reachable_ground_cells(world, trav, start_reach, pipeline.map(), map_from_world);
       result.reachable_cells = ground.size();
     }
-    step.prior_pose = mission.prior(step.reported_pose);  // the reported pose before any anchor
-    if (const auto m = mission.place(cloud, step.reported_pose)) {
-      step.match = m->result;
-      step.match_applied = m->applied;
-      step.placed_pose = m->placed;
-      step.match_proposed = m->proposed;
-    }
-    mission.add(cloud, {step.reported_pose, step.placed_pose, step.match_applied});
+    place(mission, cloud, step);
     if (!result.steps.empty()) {
       const LoopStep& first = result.steps.front();
-      const PoseError e =
-          placed_error(first.placed_pose, first.true_pose, step.placed_pose, step.true_pose);
-      step.placed_error_m = e.metres;
-      step.placed_error_deg = e.degrees;
+      const auto error = [&](const Pose& p, double& metres, double& degrees) {
+        const PoseError e = placed_error(first.placed_pose, first.true_pose, p, step.true_pose);
+        metres = e.metres;
+        degrees = e.degrees;
+      };
+      error(step.placed_pose, step.placed_error_m, step.placed_error_deg);
+      error(step.matched_pose, step.matched_error_m, step.matched_error_deg);
       if (step.match_proposed) {
-        const PoseError m =
-            placed_error(first.placed_pose, first.true_pose, *step.match_proposed, step.true_pose);
-        step.match_error_m = m.metres;
-        step.match_error_deg = m.degrees;
+        double m = 0, d = 0;
+        error(*step.match_proposed, m, d);
+        step.match_error_m = m;
+        step.match_error_deg = d;
       }
     }
 
@@ -160,7 +211,9 @@ LoopResult run_closed_loop(
       step.plan_ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       step.candidates = plan.ranked;
+      const double before = path_m;
       step.chosen = drive_to_best(trav, plan.ranked, world_from_map, truth, path_m);
+      if (step.chosen) odometry.moved(truth, path_m - before);
     }
     if (on_step) on_step(step, pipeline);
     result.steps.push_back(std::move(step));
@@ -176,6 +229,7 @@ LoopResult run_closed_loop(
     }
     if (last) result.stopped_because = "scan limit reached";
   }
+  final_errors(mission, result);
   return result;
 }
 

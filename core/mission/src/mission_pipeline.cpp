@@ -1,9 +1,34 @@
 #include "scanplan/mission/mission_pipeline.hpp"
 
+#include <cmath>
 #include <utility>
 
 namespace scanplan {
 namespace {
+
+// A move smaller than this is not worth telling anyone about (the range noise is 1 cm).
+constexpr double kNoticeableM = 0.005;
+constexpr double kNoticeableDeg = 0.01;
+
+struct PoseChange {
+  double metres = 0, degrees = 0;
+};
+
+PoseChange change(const Pose& a, const Pose& b) {
+  return {std::hypot(b.x - a.x, b.y - a.y, b.z - a.z),
+          std::abs(rad2deg(std::remainder(b.yaw - a.yaw, 2 * M_PI)))};
+}
+
+// `config` reaching as far as the pose it starts from may be off (ScanGraph's uncertainty).
+MapMatchConfig widened(MapMatchConfig config, const MoveUncertainty& prior) {
+  config.registration = widened(config.registration, prior);
+  config.max_correction_m =
+      std::max(config.max_correction_m,
+               std::min(3 * std::sqrt(2.0) * prior.xy_m, std::sqrt(2.0) * kWidestSearchM));
+  config.max_correction_deg =
+      std::max(config.max_correction_deg, std::min(3 * prior.yaw_deg, kWidestSearchDeg));
+  return config;
+}
 
 // The pipeline's region thresholds are the planner's: one set, changed by the operator.
 PipelineConfig with_planner_thresholds(PipelineConfig mapping, const PlannerConfig& planner) {
@@ -18,7 +43,23 @@ MissionPipeline::MissionPipeline(MissionConfig config)
     : config_(std::move(config)),
       mapping_(with_planner_thresholds(config_.mapping, config_.planner)),
       sensor_frame_(config_.pose_noise) {
-  if (config_.matching) anchored_map_.emplace(config_.mapping.mls);
+  if (config_.matching && config_.graph) {
+    graph_.emplace(*config_.graph, config_.pose_noise);
+  } else if (config_.matching) {
+    anchored_map_.emplace(config_.mapping.mls);
+  }
+}
+
+Pose MissionPipeline::prior(const Pose& reported, const std::string& track) const {
+  if (graph_ && config_.pose_noise.model == OdometryModel::kDrift) {
+    if (const auto last = graph_->last_anchored_of(track)) {
+      // Odometry is good over one move and bad over a mission: carry the moves since the
+      // robot's latest scan the map could place, not the frame.
+      return compose(graph_->poses()[*last], relative_pose(graph_->reported(*last), reported),
+                     reported.roll, reported.pitch);
+    }
+  }
+  return sensor_frame_.to_map(reported);
 }
 
 bool MissionPipeline::has_map() const {
@@ -26,16 +67,22 @@ bool MissionPipeline::has_map() const {
 }
 
 std::optional<MissionPipeline::MatchInput> MissionPipeline::match_input(
-    const Pose& reported) const {
+    const Pose& reported, const std::string& track) const {
   if (!config_.matching || placed_.empty()) return std::nullopt;
-  const Pose start = prior(reported);
-  return MatchInput{
-      points_near(start.x, start.y, config_.matching->target_radius_m, /*anchored_only=*/true),
-      *config_.matching, start};
+  const Pose start = prior(reported, track);
+  MapMatchConfig config = *config_.matching;
+  if (graph_) {
+    if (const auto prior = graph_->prior_uncertainty(track, reported)) {
+      config = widened(config, *prior);
+    }
+  }
+  return MatchInput{points_near(start.x, start.y, config.target_radius_m, /*anchored_only=*/true),
+                    config, start};
 }
 
-std::optional<MapMatch> MissionPipeline::place(const PointCloud& scan, const Pose& reported) const {
-  const std::optional<MatchInput> in = match_input(reported);
+std::optional<MapMatch> MissionPipeline::place(const PointCloud& scan, const Pose& reported,
+                                               const std::string& track) const {
+  const std::optional<MatchInput> in = match_input(reported, track);
   if (!in) return std::nullopt;
   return match_to_map(in->map_points, scan, in->prior, in->config);
 }
@@ -60,17 +107,140 @@ std::shared_ptr<const PointCloud> MissionPipeline::add(const PointCloud& scan,
 
 void MissionPipeline::add(const PointCloud& scan, const Placement& where,
                           std::shared_ptr<const PointCloud> in_map) {
-  mapping_.add_scan(scan, where.placed);
   const bool anchored = placed_.empty() || where.matched;
   anchored_.push_back(anchored ? 1 : 0);
-  if (anchored) {
-    sensor_frame_.add(where.reported, where.placed);
+  placed_.push_back(std::move(in_map));
+  reported_.push_back(where.reported);
+  poses_.push_back(where.placed);
+  cloud_poses_.push_back(where.placed);
+  anchored_near_.push_back(0);
+  in_map_.push_back(0);
+  if (!graph_) {
+    join_map(scan, placed_.size() - 1);
+    return;
+  }
+  const std::vector<Pose> before = poses_;
+  GraphUpdate update = graph_->add(scan, where);
+  follow_graph();
+  if (rematch_refused(update)) follow_graph();
+  last_correction_ = correction(update, before);
+}
+
+void MissionPipeline::join_map(const PointCloud& own, std::size_t i) {
+  mapping_.add_scan(own, poses_[i]);
+  in_map_[i] = 1;
+  if (anchored_[i]) {
+    sensor_frame_.add(reported_[i], poses_[i]);
     if (anchored_map_) {
-      anchored_map_->insert_scan(scan, where.placed.isometry(),
+      anchored_map_->insert_scan(own, poses_[i].isometry(),
                                  Eigen::Vector3d(0, 0, config_.mapping.sensor_height_m));
     }
   }
-  placed_.push_back(std::move(in_map));
+}
+
+PointCloud MissionPipeline::own_frame(std::size_t i) const {
+  const Eigen::Isometry3f own_from_map = cloud_poses_[i].isometry().inverse().cast<float>();
+  const PointCloud& in_map = *placed_[i];
+  PointCloud own;
+  own.reserve(in_map.size());
+  for (std::size_t p = 0; p < in_map.size(); ++p) {
+    own.push_back(own_from_map * in_map.points[p], in_map.colors[p]);
+  }
+  return own;
+}
+
+// A scan the map matcher refused when it came may match once more of the map is anchored
+// around it: the scans after it fill in what it overlaps with (issue 15's refusals were mostly
+// scans with too little anchored in view).
+bool MissionPipeline::rematch_refused(GraphUpdate& update) {
+  const double radius = config_.matching->target_radius_m;
+  bool any = false;
+  for (std::size_t u = 0; u + 1 < placed_.size(); ++u) {  // the newest was matched just now
+    if (anchored_[u]) continue;
+    const Pose& at = poses_[u];
+    std::size_t near = 0;
+    for (std::size_t j = 0; j < placed_.size(); ++j) {
+      near += anchored_[j] && std::hypot(poses_[j].x - at.x, poses_[j].y - at.y) <= radius;
+    }
+    if (near <= anchored_near_[u]) continue;
+    anchored_near_[u] = near;
+    ++update.rematches_tried;
+    const MapMatch m =
+        match_to_map(points_near(at.x, at.y, radius, /*anchored_only=*/true), graph_->thinned(u),
+                     level(at), widened(*config_.matching, graph_->uncertainty(u)));
+    if (!m.applied) continue;
+    graph_->add_match_to_map(u, m.placed, m.information);
+    ++update.rematched;
+    any = true;
+  }
+  if (any) update.solve = graph_->solve();
+  return any;
+}
+
+MapCorrection MissionPipeline::correction(const GraphUpdate& update,
+                                          const std::vector<Pose>& before) const {
+  MapCorrection c{update, {}, 0, 0};
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    const PoseChange d = change(before[i], poses_[i]);
+    if (d.metres > kNoticeableM || d.degrees > kNoticeableDeg) c.moved.push_back(i);
+    c.max_moved_m = std::max(c.max_moved_m, d.metres);
+    c.max_turned_deg = std::max(c.max_turned_deg, d.degrees);
+  }
+  return c;
+}
+
+// The map follows the graph: the anchored scans are in it, at the graph's poses. The newest
+// scan joins as usual; an older one that was anchored late, one that lost its anchoring, or one
+// that moved far enough to matter has the map rebuilt.
+void MissionPipeline::follow_graph() {
+  const std::size_t newest = placed_.size() - 1;
+  bool rebuild = false;
+  for (std::size_t i = 0; i < placed_.size(); ++i) {
+    anchored_[i] = graph_->anchored(i) ? 1 : 0;
+    const Pose& now = graph_->poses()[i];
+    // Against the map as it stands, not the graph's previous estimate: small moves add up.
+    const PoseChange d = change(poses_[i], now);
+    if (in_map_[i] &&
+        (!anchored_[i] || d.metres > config_.replace_m || d.degrees > config_.replace_deg)) {
+      rebuild = true;
+    }
+    if (!in_map_[i] && anchored_[i] && i != newest) rebuild = true;
+    if (!in_map_[i] || rebuild) poses_[i] = now;
+  }
+  if (rebuild) {
+    poses_ = graph_->poses();
+    replace();
+  } else if (anchored_[newest] && !in_map_[newest]) {
+    poses_[newest] = graph_->poses()[newest];
+    join_map(own_frame(newest), newest);
+  }
+  // The points shown follow the graph wherever the scan is, in the map or not.
+  for (std::size_t i = 0; i < placed_.size(); ++i) {
+    const PoseChange d = change(cloud_poses_[i], poses_[i]);
+    if (d.metres > kNoticeableM || d.degrees > kNoticeableDeg) {
+      placed_[i] = to_map_frame(own_frame(i), poses_[i]);
+      cloud_poses_[i] = poses_[i];
+    }
+  }
+}
+
+// The anchored scans back in at their poses: the MLS map cannot take one scan out, and
+// rebuilding it costs a few milliseconds a scan (docs/benchmarks.md mls_campus).
+void MissionPipeline::replace() {
+  const std::optional<TargetRegion> target = mapping_.target();
+  mapping_ = MappingPipeline(with_planner_thresholds(config_.mapping, config_.planner));
+  if (target) mapping_.set_target(*target);
+  if (anchored_map_) anchored_map_.emplace(config_.mapping.mls);
+  sensor_frame_ = SensorFrame(config_.pose_noise);
+  for (std::size_t i = 0; i < placed_.size(); ++i) {
+    in_map_[i] = 0;
+    PointCloud own = own_frame(i);
+    if (change(cloud_poses_[i], poses_[i]).metres > 0 || cloud_poses_[i].yaw != poses_[i].yaw) {
+      placed_[i] = to_map_frame(own, poses_[i]);
+      cloud_poses_[i] = poses_[i];
+    }
+    if (anchored_[i]) join_map(own, i);
+  }
 }
 
 std::vector<FleetPlan> MissionPipeline::plan(const std::vector<FleetRobot>& robots,

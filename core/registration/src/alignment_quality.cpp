@@ -91,6 +91,14 @@ AlignmentQuality AlignmentJudge::evaluate(const PointCloud& source,
     info += a * a.transpose();
   }
   info /= static_cast<double>(q.inliers);
+  const Eigen::Vector3d origin = source_to_target.translation();
+  Eigen::Vector4d b;
+  for (const auto& [p, n] : planar) {
+    b.head<3>() = n;
+    b[3] = (p - origin).cross(n).z();
+    q.information += b * b.transpose();
+  }
+  q.information /= static_cast<double>(q.inliers);
   q.weakest_constraint = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(info).eigenvalues()[0];
   return q;
 }

@@ -86,6 +86,29 @@ bool holds_on_restart(const GicpMatcher& gicp, const Eigen::Isometry3d& at,
   return true;
 }
 
+// Another result that passed the check almost as well as `best` but lies elsewhere: why the
+// match is ambiguous, or nothing.
+std::optional<std::string> ambiguous(
+    const Eigen::Isometry3d& best, std::size_t inliers,
+    const std::vector<std::pair<Eigen::Isometry3d, std::size_t>>& passed,
+    const PoseSearchConfig& c) {
+  for (const auto& [other, other_inliers] : passed) {
+    const Eigen::Isometry3d off = best.inverse() * other;
+    const double metres = off.translation().head<2>().norm();
+    const double degrees = rad2deg(Eigen::AngleAxisd(off.linear()).angle());
+    if ((metres > c.min_separation_m || degrees > c.min_separation_deg) &&
+        static_cast<double>(other_inliers) >= c.ambiguity_ratio * static_cast<double>(inliers)) {
+      char why[160];
+      std::snprintf(why, sizeof why,
+                    "ambiguous: a pose %.1f m and %.1f° away fits almost as well (a repeated "
+                    "structure); not believed",
+                    metres, degrees);
+      return std::string(why);
+    }
+  }
+  return std::nullopt;
+}
+
 // GICP from the peaks of the pose search, best first (from `initial` when the search finds
 // none), until a result passes the sanity check; if none does, the one that came closest. A
 // search peak can be a false one (a facade shifted along itself, a repeated row of cars); the
@@ -106,19 +129,28 @@ RegistrationResult align_search_gicp(const PointCloud& target, const PointCloud&
   int best_rank = -1;
   std::size_t best_inliers = 0;
   int iterations = 0;
+  const bool check_ambiguity = c.search.ambiguity_ratio > 0;
+  std::vector<std::pair<Eigen::Isometry3d, std::size_t>> passed;  // transform, inliers
   for (const PoseHypothesis& start : starts) {
     RegistrationResult r = gicp.align(start.transform, c.dof);
     iterations += r.iterations;
     const AlignmentQuality q = judge.evaluate(sample, r.transform, c.dof, c.score_max_distance_m,
                                               c.inlier_distance_m, r.converged);
     const int rank = r.converged ? (rejection(q, c) ? 1 : 2) : 0;
+    if (rank == 2) passed.emplace_back(r.transform, q.inliers);
     if (rank > best_rank || (rank == best_rank && q.inliers > best_inliers)) {
       best = std::move(r);
       best_q = q;
       best_rank = rank;
       best_inliers = q.inliers;
     }
-    if (best_rank == 2) break;
+    if (best_rank == 2 && !check_ambiguity) break;
+  }
+  if (best_rank == 2 && check_ambiguity) {
+    if (const auto rival = ambiguous(best.transform, best_inliers, passed, c.search)) {
+      best.converged = false;
+      best.message = *rival;
+    }
   }
   // Refused only for its weakest constraint: restarts from around it tell whether it holds.
   const double shift = (best.transform.translation() - initial.translation()).head<2>().norm();
@@ -267,6 +299,7 @@ RegistrationResult register_with(const PointCloud& target, const PointCloud& sou
   r.rmse = q.rmse;
   r.inlier_ratio = q.inlier_ratio;
   r.weakest_constraint = q.weakest_constraint;
+  r.information = q.information;
   if (r.converged) {
     if (std::optional<std::string> why = rejection(q, c, r.held_on_restart)) {
       r.converged = false;

@@ -98,14 +98,4 @@ PointCloud simulate_scan(const RayCaster& caster, const ScannerConfig& config,
   return cloud;
 }
 
-Pose reported_pose(const Pose& truth, const PoseNoise& noise, std::mt19937_64& rng) {
-  std::normal_distribution<double> n01(0.0, 1.0);
-  Pose p = truth;
-  p.x += noise.xy_sigma_m * n01(rng);
-  p.y += noise.xy_sigma_m * n01(rng);
-  p.z += noise.z_sigma_m * n01(rng);
-  p.yaw += deg2rad(noise.yaw_sigma_deg) * n01(rng);
-  return p;
-}
-
 }  // namespace scanplan

@@ -269,10 +269,20 @@ void parse_scanner(Fields& f, ScannerConfig& s) {
 }
 
 void parse_pose_noise(Fields& f, PoseNoise& n) {
+  if (f.has("model")) {
+    const std::string name = f.string("model");
+    const auto model = parse_odometry_model(name);
+    if (!model) f.fail("model", "must be \"drift\" or \"absolute\", not \"" + name + "\"");
+    n.model = *model;
+  }
   n.xy_sigma_m = f.number_or("xy_sigma_m", n.xy_sigma_m);
   n.z_sigma_m = f.number_or("z_sigma_m", n.z_sigma_m);
   n.yaw_sigma_deg = f.number_or("yaw_sigma_deg", n.yaw_sigma_deg);
-  if (n.xy_sigma_m < 0 || n.z_sigma_m < 0 || n.yaw_sigma_deg < 0)
+  n.xy_drift_fraction = f.number_or("xy_drift_fraction", n.xy_drift_fraction);
+  n.yaw_drift_deg_per_10m = f.number_or("yaw_drift_deg_per_10m", n.yaw_drift_deg_per_10m);
+  n.z_drift_fraction = f.number_or("z_drift_fraction", n.z_drift_fraction);
+  if (n.xy_sigma_m < 0 || n.z_sigma_m < 0 || n.yaw_sigma_deg < 0 || n.xy_drift_fraction < 0 ||
+      n.yaw_drift_deg_per_10m < 0 || n.z_drift_fraction < 0)
     f.fail("", "sigmas must not be negative");
   f.no_unknown_keys();
 }

@@ -16,7 +16,7 @@ World coloured_world() {
         {"type": "box", "min": [-8, -2, 0], "max": [-7, 5, 5], "color": [40, 60, 220]},
         {"type": "box", "min": [-2, 6, 0], "max": [3, 7, 2], "color": [230, 200, 40]}
       ],
-      "start": [0, 0, 0], "pose_noise": {"xy_sigma_m": 0, "z_sigma_m": 0, "yaw_sigma_deg": 0}})",
+      "start": [0, 0, 0], "pose_noise": {"model": "absolute", "xy_sigma_m": 0, "z_sigma_m": 0, "yaw_sigma_deg": 0}})",
                      "colours.json");
 }
 

@@ -82,7 +82,9 @@ TEST_F(MissionPipelineTest, ASecondScanIsPlacedBackOnItsTruePose) {
 }
 
 TEST_F(MissionPipelineTest, OnlyAnchoredScansAreMatchedAgainst) {
-  MissionPipeline mission(config());
+  MissionConfig without_graph = config();
+  without_graph.graph.reset();  // the graph would match the two scans with each other
+  MissionPipeline mission(without_graph);
   mission.add(scan_at(at(-15, -8, 0), 1), {at(-15, -8, 0), at(-15, -8, 0)});
   EXPECT_TRUE(mission.anchored(0)) << "the first scan defines the map frame";
   // A scan whose match was refused stays at its reported pose, 2 m off: in the map, but not
@@ -97,6 +99,44 @@ TEST_F(MissionPipelineTest, OnlyAnchoredScansAreMatchedAgainst) {
   ASSERT_TRUE(in);
   EXPECT_EQ(in->map_points.size(),
             mission.points_near(off.x, off.y, in->config.target_radius_m, true).size());
+}
+
+// With the graph, the refused scan is matched with the first pairwise (their relative pose is
+// known to the odometry's accuracy), joins the map at its true pose, and is anchored.
+TEST_F(MissionPipelineTest, TheGraphPlacesAScanTheMapMatchRefused) {
+  MissionPipeline mission(config());
+  mission.add(scan_at(at(-15, -8, 0), 1), {at(-15, -8, 0), at(-15, -8, 0)});
+  Placement refused(at(-3, -7, 0), at(-3, -7, 0));  // 2 m off, as a refused match leaves it
+  const PointCloud second = scan_at(at(-5, -9, 0), 2);
+  mission.add(second, refused);
+  EXPECT_TRUE(mission.anchored(1));
+  EXPECT_TRUE(mission.in_map(1));
+  EXPECT_NEAR(mission.poses()[1].x, -5, 0.03);
+  EXPECT_NEAR(mission.poses()[1].y, -9, 0.03);
+  ASSERT_TRUE(mission.last_correction());
+  EXPECT_EQ(mission.last_correction()->graph.pairs_matched, 1u);
+  EXPECT_EQ(mission.last_correction()->moved, std::vector<std::size_t>{1});
+  EXPECT_NEAR(mission.last_correction()->max_moved_m, std::hypot(2.0, 2.0), 0.05);
+  // Its points in the map moved with it.
+  const Eigen::Vector3f moved = mission.poses()[1].isometry().cast<float>() * second.points[0];
+  EXPECT_LT((mission.placed_scans()[1]->points[0] - moved).norm(), 1e-3);
+}
+
+// A scan nothing ties in stays out of the MLS map (no phantom walls for the planner) but is
+// kept, and its points go where the graph has it.
+TEST_F(MissionPipelineTest, AScanNothingTiesInStaysOutOfTheMap) {
+  MissionPipeline mission(config());
+  mission.add(scan_at(at(-15, -8, 0), 1), {at(-15, -8, 0), at(-15, -8, 0)});
+  const std::size_t cells = mission.mapping().map().occupied_cells();
+  PointCloud few;  // too few points to match anything
+  for (int i = 0; i < 20; ++i) few.push_back({static_cast<float>(i), 3.0f, 0.0f}, {1, 2, 3});
+  mission.add(few, {at(10, 5, 0), at(10, 5, 0)});
+  EXPECT_FALSE(mission.anchored(1));
+  EXPECT_FALSE(mission.in_map(1));
+  EXPECT_EQ(mission.mapping().scan_poses().size(), 1u);
+  EXPECT_EQ(mission.mapping().map().occupied_cells(), cells);
+  EXPECT_EQ(mission.placed_scans().size(), 2u);
+  EXPECT_EQ(mission.poses().size(), 2u);
 }
 
 TEST_F(MissionPipelineTest, WithMatchingOffScansStayWhereTheRobotSays) {

@@ -120,24 +120,5 @@ TEST(SimulatedScanner, ProgressIsReportedInOrderAndCanAbort) {
   EXPECT_TRUE(std::equal(part.points.begin(), part.points.end(), full.points.begin()));
 }
 
-TEST(SimulatedScanner, ReportedPoseNoiseHasConfiguredSpread) {
-  PoseNoise noise;
-  std::mt19937_64 rng(11);
-  const Pose truth;
-  double sx = 0, sz = 0, syaw = 0;
-  constexpr int kDraws = 20000;
-  for (int i = 0; i < kDraws; ++i) {
-    const Pose p = reported_pose(truth, noise, rng);
-    sx += p.x * p.x;
-    sz += p.z * p.z;
-    syaw += p.yaw * p.yaw;
-    ASSERT_EQ(p.roll, 0.0);
-    ASSERT_EQ(p.pitch, 0.0);
-  }
-  EXPECT_NEAR(std::sqrt(sx / kDraws), noise.xy_sigma_m, 0.03);
-  EXPECT_NEAR(std::sqrt(sz / kDraws), noise.z_sigma_m, 0.01);
-  EXPECT_NEAR(rad2deg(std::sqrt(syaw / kDraws)), noise.yaw_sigma_deg, 0.15);
-}
-
 }  // namespace
 }  // namespace scanplan

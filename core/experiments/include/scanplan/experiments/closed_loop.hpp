@@ -20,6 +20,9 @@ struct ClosedLoopConfig {
   // Scan matching of each new scan against the map so far (paper §4); nothing: scans are placed
   // at the reported pose.
   std::optional<MapMatchConfig> matching = MapMatchConfig{};
+  // The pose graph over the scans (with matching on); nothing: each scan stays where its
+  // match put it.
+  std::optional<ScanGraphConfig> graph = ScanGraphConfig{};
 };
 
 // One scan of the loop and the decision taken after it.
@@ -27,8 +30,12 @@ struct LoopStep {
   int scan = 0;        // 1-based
   Pose true_pose;      // where the robot really scanned
   Pose reported_pose;  // what the robot's pose sensors said
-  Pose placed_pose;    // where the map put the scan (matched when matching is on)
-  Pose prior_pose;     // the reported pose carried into the map frame: where matching started
+  Pose matched_pose;   // where matching put the scan (the reported pose when it was refused)
+  // Where the map had the scan once the pose graph was optimised after it joined (matched_pose
+  // with the graph off), and where the graph had it when the mission ended.
+  Pose placed_pose;
+  Pose final_pose;
+  Pose prior_pose;  // the reported pose carried into the map frame: where matching started
   std::optional<RegistrationResult> match;  // when the scan was matched against the map
   bool match_applied = false;               // whether placed_pose is the match's correction
   // How far the match's result was from the truth (relative to the first scan), applied or
@@ -39,6 +46,17 @@ struct LoopStep {
   // frame): what a rescue crew reading the map would be misled by.
   double placed_error_m = 0;
   double placed_error_deg = 0;
+  // The same for matched_pose (before the graph) and final_pose.
+  double matched_error_m = 0, matched_error_deg = 0;
+  double final_error_m = 0, final_error_deg = 0;
+  // The graph's work after this scan: pairs matched of those tried, the solve, and how far it
+  // moved the scans already in the map.
+  std::size_t pairs_tried = 0, pairs_matched = 0;
+  std::size_t rematches_tried = 0, rematched = 0;  // earlier refused scans matched again
+  double graph_ms = 0;                             // pairwise matches and the solve
+  double solve_ms = 0;
+  double corrected_max_m = 0;  // the largest move of any scan in this step's optimisation
+  std::size_t corrected_scans = 0;
   double detected_m2 = 0;             // C ∪ M, the paper's detection area
   double completed_m2 = 0;            // C
   double coverage_pct = 0;            // reachable ground cells of the target region that are in C
@@ -60,8 +78,17 @@ struct PoseError {
 PoseError placed_error(const Pose& first_placed, const Pose& first_true, const Pose& placed,
                        const Pose& truth);
 
+// One edge of the pose graph at the end of the run, judged against the truth.
+struct LoopEdge {
+  std::size_t from = 0, to = 0;       // scans, 0-based
+  std::string origin;                 // ScanGraph::edge_origin
+  double error_m = 0, error_deg = 0;  // the measured relative pose against the true one
+  double whitened = 0;                // PoseGraph::whitened_error at the end
+};
+
 struct LoopResult {
   std::vector<LoopStep> steps;
+  std::vector<LoopEdge> edges;      // empty with the graph off
   std::size_t reachable_cells = 0;  // the coverage denominator
   std::optional<int> scans_to_95pct;
   std::optional<double> path_to_95pct_m;

@@ -9,6 +9,8 @@
 #include "scanplan/geometry/point_cloud.hpp"
 #include "scanplan/geometry/pose.hpp"
 #include "scanplan/mapping/mapping_pipeline.hpp"
+#include "scanplan/mission/placement.hpp"
+#include "scanplan/mission/scan_graph.hpp"
 #include "scanplan/mission/sensor_frame.hpp"
 #include "scanplan/planning/fleet_planner.hpp"
 #include "scanplan/planning/scan_planner.hpp"
@@ -24,15 +26,27 @@ struct MissionConfig {
   // Scan matching of each new scan against the map so far (paper §4); nothing: scans go where
   // the robot says they are.
   std::optional<MapMatchConfig> matching = MapMatchConfig{};
-  // How wrong a reported pose is, for carrying it into the map frame (SensorFrame).
-  PoseSensorNoise pose_noise;
+  // How wrong a reported pose is: for carrying it into the map frame (SensorFrame) and for
+  // weighing the robot's odometry in the pose graph.
+  PoseNoise pose_noise;
+  // The pose graph over the scans (issue 17), used while matching is on; nothing: each scan
+  // stays where its match to the map put it.
+  std::optional<ScanGraphConfig> graph = ScanGraphConfig{};
+  // When the graph moves any scan farther than this, the map is rebuilt at the new poses (the
+  // MLS map's cells are 1 m; a smaller correction changes nothing an operator or the planner
+  // can see).
+  double replace_m = 0.02;
+  double replace_deg = 0.05;
 };
 
-// Where a scan joins the map, and how it got there.
-struct Placement {
-  Pose reported;         // what the robot's pose sensors said (their frame)
-  Pose placed;           // where the scan goes in the map frame
-  bool matched = false;  // placed by a match the sanity check believed
+// How the map changed when the graph moved scans after the latest one joined.
+struct MapCorrection {
+  GraphUpdate graph;
+  // The scans (in joining order) whose pose in the map moved more than 5 mm or 0.01°; the map
+  // is rebuilt only when one moves past MissionConfig::replace_m / _deg, so smaller moves wait
+  // until they add up.
+  std::vector<std::size_t> moved;
+  double max_moved_m = 0, max_turned_deg = 0;
 };
 
 // The paper's loop as one object (§3 steps 1–4 with §4's matching), used alike by the server
@@ -50,7 +64,8 @@ class MissionPipeline {
   // frame, and those placed by a match the sanity check believed. A scan left unmatched is
   // metres off as often as not; matched against, it would pull every later scan near it off
   // with it. Nothing when matching is off or nothing is anchored yet. Changes nothing.
-  std::optional<MapMatch> place(const PointCloud& scan, const Pose& reported) const;
+  std::optional<MapMatch> place(const PointCloud& scan, const Pose& reported,
+                                const std::string& track = {}) const;
   // place() in two steps, for an owner that matches without holding its lock: what the match
   // needs from the map (nothing when there is nothing to match against), then match_to_map.
   struct MatchInput {
@@ -58,15 +73,19 @@ class MissionPipeline {
     MapMatchConfig config;
     Pose prior;  // the reported pose in the map frame: where the match starts
   };
-  std::optional<MatchInput> match_input(const Pose& reported) const;
+  std::optional<MatchInput> match_input(const Pose& reported, const std::string& track = {}) const;
   // `reported` carried into the map frame by what the anchored scans say of the pose sensors'
   // frame (SensorFrame): where an unmatched scan is best placed.
-  Pose prior(const Pose& reported) const { return sensor_frame_.to_map(reported); }
+  // With drifting odometry and the graph on, the robot's latest scan as the graph has it,
+  // moved by what its odometry reports since (`track`: the robot id).
+  Pose prior(const Pose& reported, const std::string& track = {}) const;
 
   // Mapped and segmented: the scan joins the map at `where.placed`; it is anchored when a
   // believed match placed it (see place(); the first scan is anchored regardless). Returns its
   // points in the map frame (coloured; grey where the scan had no colour), shared, never
-  // copied again.
+  // copied again. With the graph on, the scan is then matched with its neighbours and the graph
+  // optimised; where that moves scans, the map follows (last_correction()), and the points
+  // returned are where the scan lay when it joined.
   std::shared_ptr<const PointCloud> add(const PointCloud& scan, const Placement& where);
   // The same with the points in the map frame already made (to_map_frame).
   void add(const PointCloud& scan, const Placement& where,
@@ -87,13 +106,27 @@ class MissionPipeline {
   // The map's points (map frame) within `radius_m` of (x, y) in the x-y plane; only the
   // anchored scans' when `anchored_only`.
   PointCloud points_near(double x, double y, double radius_m, bool anchored_only = false) const;
-  // Whether the i-th scan (in the order they joined) is anchored (see place()).
+  // Whether the i-th scan (in the order they joined) is anchored (see place(); with the graph,
+  // whether believed matches tie it to the first scan).
   bool anchored(std::size_t i) const { return anchored_.at(i) != 0; }
+  // Each scan's pose in the map, in joining order (the graph's latest estimate).
+  const std::vector<Pose>& poses() const { return poses_; }
+  // Whether the i-th scan is in the MLS map (mapping()): with the graph on, only anchored
+  // scans are, so that one left metres off makes no phantom walls and steps for the planner;
+  // it joins once a match ties it in.
+  bool in_map(std::size_t i) const { return in_map_.at(i) != 0; }
+  // What the graph did after the latest scan; nothing with the graph off.
+  const std::optional<MapCorrection>& last_correction() const { return last_correction_; }
+  const ScanGraph* graph() const { return graph_ ? &*graph_ : nullptr; }
   // Each scan's points in the map frame, in the order they joined.
   const std::vector<std::shared_ptr<const PointCloud>>& placed_scans() const { return placed_; }
   const MappingPipeline& mapping() const { return mapping_; }
-  // The map of the anchored scans; nothing when matching is off.
-  const MlsMap* anchored_map() const { return anchored_map_ ? &*anchored_map_ : nullptr; }
+  // The map of the anchored scans (with the graph on, mapping()'s); nothing when matching is
+  // off.
+  const MlsMap* anchored_map() const {
+    if (graph_) return &mapping_.map();  // it holds the anchored scans alone
+    return anchored_map_ ? &*anchored_map_ : nullptr;
+  }
   const PlannerConfig& planner() const { return config_.planner; }
   const MissionConfig& config() const { return config_; }
   // Whether there is a map to plan on (a first scan, its regions and movable region).
@@ -108,6 +141,22 @@ class MissionPipeline {
   // kept only while matching is on.
   std::optional<MlsMap> anchored_map_;
   SensorFrame sensor_frame_;
+  std::vector<Pose> reported_;     // per scan, for refitting sensor_frame_
+  std::vector<Pose> poses_;        // per scan: where it is (the graph's estimate)
+  std::vector<Pose> cloud_poses_;  // per scan: the pose its placed_ points were put at
+  std::vector<std::uint8_t> in_map_;
+  std::optional<ScanGraph> graph_;
+  std::optional<MapCorrection> last_correction_;
+  // Per scan: how many anchored scans lay near it when it was last matched to the map; it is
+  // tried again when more do.
+  std::vector<std::size_t> anchored_near_;
+
+  bool rematch_refused(GraphUpdate& update);
+  void follow_graph();
+  void join_map(const PointCloud& own, std::size_t i);
+  PointCloud own_frame(std::size_t i) const;
+  MapCorrection correction(const GraphUpdate& update, const std::vector<Pose>& before) const;
+  void replace();
 };
 
 }  // namespace scanplan

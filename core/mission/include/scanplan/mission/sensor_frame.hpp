@@ -3,14 +3,9 @@
 #include <vector>
 
 #include "scanplan/geometry/pose.hpp"
+#include "scanplan/geometry/pose_noise.hpp"
 
 namespace scanplan {
-
-// How wrong the robot's pose sensors are, one scan at a time (DESIGN.md: σ 1 m, 5°).
-struct PoseSensorNoise {
-  double xy_sigma_m = 1.0;
-  double yaw_sigma_deg = 5.0;
-};
 
 // Where the robot's pose-sensor frame lies in the map frame (ROS's map → odom). The first scan
 // defines the map frame at the pose it was reported at, errors included: 5° of yaw error there
@@ -26,7 +21,7 @@ struct PoseSensorNoise {
 // over the anchored scans: positions far apart fix θ better than the yaw readings do.
 class SensorFrame {
  public:
-  explicit SensorFrame(PoseSensorNoise noise = {}) : noise_(noise) {}
+  explicit SensorFrame(PoseNoise noise = {}) : noise_(noise) {}
 
   // One scan whose map pose is known: the first, or one placed by a believed match.
   void add(const Pose& reported, const Pose& placed);
@@ -37,7 +32,7 @@ class SensorFrame {
  private:
   void refit();
 
-  PoseSensorNoise noise_;
+  PoseNoise noise_;
   std::vector<Pose> reported_, placed_;
   double yaw_ = 0, tx_ = 0, ty_ = 0, tz_ = 0;  // map_from_sensor
 };

@@ -26,6 +26,14 @@ struct AlignmentQuality {
   // constrain that direction: near 0 in a corridor (nothing stops sliding along it) or on open
   // ground, a few per cent and more where walls face several ways.
   double weakest_constraint = 0;
+  // What the same inliers say of the pose's uncertainty, for the pose graph: Σ a·aᵀ / inliers
+  // with a = [n; ((p − o) × n)_z], o the source's origin in the target frame, over x, y, z
+  // (metres) and the yaw about o (radians). Divided by the variance of one point-to-plane
+  // distance it is the information of the 4 parameters, as if the whole match weighed as
+  // much as one point on every surface it touches: points on the same wall are not independent
+  // measurements, and counting each would make every match look millimetre-sure. Zero unless
+  // with_constraint.
+  Eigen::Matrix4d information = Eigen::Matrix4d::Zero();
 };
 
 namespace detail {

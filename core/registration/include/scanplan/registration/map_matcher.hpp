@@ -35,7 +35,10 @@ struct MapMatch {
   // alignment ran): what a refused match proposed, for whoever studies the refusals.
   Pose proposed;
   RegistrationResult result;
-  bool applied = false;   // whether `placed` is the matcher's correction
+  bool applied = false;  // whether `placed` is the matcher's correction
+  // The result's AlignmentQuality::information with its x-y turned into the map frame (zero
+  // when no alignment settled), for the pose graph.
+  Eigen::Matrix4d information = Eigen::Matrix4d::Zero();
   bool levelled = false;  // refused, and `placed` raised or lowered onto the map's ground
 };
 

@@ -31,6 +31,11 @@ struct PoseSearchConfig {
   int hypotheses = 3;
   double min_separation_m = 1.5;
   double min_separation_deg = 5.0;
+  // Above 0, search-gicp refines every peak, and when two distinct ones both pass the sanity
+  // check, the lesser with at least this share of the better one's inliers, the match is
+  // refused as ambiguous: a search wider than the spacing of a repeated structure (a row of
+  // equal buildings, parked cars) finds the same fit shifted by one period.
+  double ambiguity_ratio = 0;
 };
 
 struct PoseHypothesis {

@@ -29,6 +29,9 @@ struct RegistrationResult {
   // The weakest constraint was below the check's, but restarts from around the result all came
   // back to it (RegistrationConfig::restart_check), so it was believed.
   bool held_on_restart = false;
+  // AlignmentQuality::information at the result (x, y, z, yaw about the source's origin, in
+  // the target frame); zero when the solver did not settle.
+  Eigen::Matrix4d information = Eigen::Matrix4d::Zero();
   int iterations = 0;  // summed over all stages (cell sizes, NDT then ICP)
   double time_ms = 0;  // the alignment itself: downsampling and scoring excluded
   bool converged =

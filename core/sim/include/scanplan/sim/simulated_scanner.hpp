@@ -24,7 +24,4 @@ PointCloud simulate_scan(const RayCaster& caster, const ScannerConfig& config,
                          const Pose& true_pose, std::uint64_t seed,
                          const ScanProgressFn& progress = {}, int num_threads = 0);
 
-// The pose the robot would report at `truth`: x, y, z and yaw disturbed, roll/pitch exact.
-Pose reported_pose(const Pose& truth, const PoseNoise& noise, std::mt19937_64& rng);
-
 }  // namespace scanplan

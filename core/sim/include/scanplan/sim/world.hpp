@@ -9,10 +9,10 @@
 
 #include "scanplan/geometry/point_cloud.hpp"
 #include "scanplan/geometry/pose.hpp"
+#include "scanplan/geometry/pose_noise.hpp"
 #include "scanplan/geometry/scanner_model.hpp"
 #include "scanplan/geometry/target_region.hpp"
 #include "scanplan/sim/height_grid.hpp"
-#include "scanplan/sim/pose_noise.hpp"
 
 namespace scanplan {
 
@@ -80,7 +80,8 @@ struct World {
   std::vector<WorldRamp> ramps;
   Pose start;  // z is the ground height under the start
   ScannerConfig scanner;
-  PoseNoise pose_noise;
+  // Drifting odometry unless the world file says otherwise (DESIGN.md "Scanner model").
+  PoseNoise pose_noise{.model = OdometryModel::kDrift};
 
   // The height of the ground surface alone (objects standing on it are not counted).
   double ground_height(double x, double y) const;

@@ -1,0 +1,27 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+
+#include "scanplan/geometry/pose.hpp"
+
+namespace scanplan {
+
+// Where a scan joins the map, and how it got there.
+struct Placement {
+  Placement() = default;
+  Placement(const Pose& reported_pose, const Pose& placed_pose, bool matched_by_match = false)
+      : reported(reported_pose), placed(placed_pose), matched(matched_by_match) {}
+
+  Pose reported;         // what the robot's pose sensors said (their frame)
+  Pose placed;           // where the scan goes in the map frame
+  bool matched = false;  // placed by a match the sanity check believed
+  // The believed match's information over (x, y, z, yaw) in the map frame (MapMatch::
+  // information); zero when the scan was not matched.
+  Eigen::Matrix4d information = Eigen::Matrix4d::Zero();
+  // Whose pose sensors reported it (the robot id): consecutive scans of one robot are related
+  // by its odometry; scans of different robots are not.
+  std::string track;
+};
+
+}  // namespace scanplan

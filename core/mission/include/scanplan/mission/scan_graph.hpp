@@ -1,0 +1,150 @@
+#pragma once
+
+#include <cstddef>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "scanplan/geometry/point_cloud.hpp"
+#include "scanplan/geometry/pose_noise.hpp"
+#include "scanplan/graph/pose_graph.hpp"
+#include "scanplan/mission/placement.hpp"
+#include "scanplan/registration/registration.hpp"
+
+namespace scanplan {
+
+struct ScanGraphConfig {
+  PoseGraphConfig solver;
+  // A new scan is matched with each earlier one whose position lies within this (x-y), the
+  // nearest first, at most max_pairs of them: pairs farther apart than the scanner's useful
+  // range share too little to be worth the time (the planner spaces scans 30–40 m).
+  double pair_radius_m = 45.0;
+  std::size_t max_pairs = 6;
+  // The pairwise match: GICP from where the graph puts the two scans when both are anchored
+  // (their relative pose is already good to centimetres), else the search over the pose
+  // sensors' uncertainty first.
+  RegistrationConfig registration;
+  // Between two anchored scans a pairwise result farther than this from their current relative
+  // pose is not believed: the graph already knows it that well.
+  double max_pair_shift_m = 1.0;
+  double max_pair_turn_deg = 3.0;
+  // Between scans of which one is not anchored: the pose sensors' reach (MapMatchConfig).
+  double max_search_shift_m = 6.0;
+  double max_search_turn_deg = 25.0;
+  // σ of one point-to-plane distance in a match (the scanner's range noise is 1 cm):
+  // AlignmentQuality::information / σ² is a match edge's information.
+  double match_sigma_m = 0.01;
+  // A pairwise match sees one scan where the map match saw all of them around: less overlap,
+  // and its errors are larger (on the campus loop: 1–7 cm where the map match's are 1 cm).
+  double pair_sigma_m = 0.03;
+  // Odometry edges: a drive around what is in the way is longer than the straight line between
+  // the two reports, and the drift grows with the path (DESIGN.md: 2 % of the distance driven).
+  double path_factor = 1.5;
+  // Odometry edges are never surer than this (a robot that did not move still slips).
+  double min_odometry_sigma_m = 0.05;
+  double min_odometry_sigma_deg = 0.05;
+};
+
+// `pose` without its tilt: the levelled frame at it (x, y, z, yaw; z vertical).
+Pose level(Pose pose);
+// `scan` (its own frame at `pose`) in the levelled frame at `pose`: the 4-DOF solver then turns
+// about the true vertical, and a transform between two levelled scans is their relative pose
+// (relative_pose) as it stands. Matched in their tilted own frames, two scans on sloping
+// ground turn about a tilted axis and their relative yaw comes out biased.
+PointCloud levelled(PointCloud scan, const Pose& pose);
+
+// How far off a pose carried by odometry from the robot's previous scan can be: σ of each x-y
+// axis and of the yaw.
+struct MoveUncertainty {
+  double xy_m = 0, z_m = 0, yaw_deg = 0;
+};
+
+// `config` whose search reaches 3σ of `prior` where that is wider than it already is
+// (scan-to-map matching and the pairwise search alike): a robot that drove 150 m on 2 %
+// odometry may be 9 m off, beyond the 6 m its GNSS-like fixes never exceed. The weak-evidence
+// limit (restart_max_shift_m) stays: far from where the sensors put it, only a match that fixes
+// the pose firmly is believed. Widened, the search looks at more peaks and refuses a fit that
+// another distinct pose matches almost as well (PoseSearchConfig::ambiguity_ratio): the wider
+// the search, the likelier it spans a repeated structure. It never reaches beyond
+// kWidestSearchM / _Deg, where a scan is better left to the graph than matched to a look-alike.
+inline constexpr double kWidestSearchM = 10.0;
+inline constexpr double kWidestSearchDeg = 45.0;
+RegistrationConfig widened(RegistrationConfig config, const MoveUncertainty& prior);
+
+// What the graph did when one scan joined.
+struct GraphUpdate {
+  std::size_t pairs_tried = 0, pairs_matched = 0;
+  double match_ms = 0;  // the pairwise matches together
+  // Scans refused when they came and matched to the map again as it grew: tried, placed.
+  std::size_t rematches_tried = 0, rematched = 0;
+  GraphSolveReport solve;
+};
+
+// The scans of a mission as a pose graph (issue 17): the robot's odometry between its
+// consecutive scans, each believed scan-to-map match, and pairwise matches between every two
+// scans near each other (so a scan that could not be matched when it came is tied in by later
+// ones, and a robot coming back near old scans closes the loop), optimised after every scan.
+// Keeps each scan thinned and levelled for the pairwise matches. Not thread-safe.
+class ScanGraph {
+ public:
+  ScanGraph(ScanGraphConfig config, PoseNoise noise);
+
+  // Scan `scan` (own frame) joins at `where`; its pairs are matched and the graph optimised.
+  GraphUpdate add(const PointCloud& scan, const Placement& where);
+  // A scan not anchored so far was matched to the map after all (MapMatch::placed and
+  // ::information): it is tied to the anchored scan nearest to where the match put it. Call
+  // solve() after.
+  void add_match_to_map(std::size_t scan, const Pose& placed, const Eigen::Matrix4d& information,
+                        const char* origin = "rematch");
+  GraphSolveReport solve();
+
+  std::size_t size() const { return graph_.size(); }
+  const std::vector<Pose>& poses() const { return graph_.poses(); }
+  // Whether believed matches (not outliers) tie the scan to the first one.
+  bool anchored(std::size_t scan) const { return anchored_.at(scan) != 0; }
+  // The latest scan of a robot, if any.
+  std::optional<std::size_t> last_of(const std::string& track) const;
+  // The latest scan of a robot that is anchored, if any.
+  std::optional<std::size_t> last_anchored_of(const std::string& track) const;
+  // How wrong odometry over `move` (reported poses) may be, by the noise model.
+  MoveUncertainty odometry_uncertainty(const RelativePose& move) const;
+  // How wrong a pose carried by odometry from the robot's latest anchored scan to `reported`
+  // may be: the error of each move since, one after the other (a heading error swinging the
+  // moves after it). Nothing for a robot's first scan or absolute fixes.
+  std::optional<MoveUncertainty> prior_uncertainty(const std::string& track,
+                                                   const Pose& reported) const;
+  const Pose& reported(std::size_t scan) const { return reported_.at(scan); }
+  // The scan levelled at its pose (levelled()), thinned as matching thins it.
+  const PointCloud& thinned(std::size_t scan) const { return *thinned_.at(scan); }
+  // How far off the scan's estimate may be while no believed match ties it in (zero once one
+  // does).
+  const MoveUncertainty& uncertainty(std::size_t scan) const { return uncertain_.at(scan); }
+  const PoseGraph& graph() const { return graph_; }
+  // How each edge of graph() came about, by index: "odometry", "pair" (GICP between anchored
+  // scans), "pair-search" (the search first: one end was not anchored), "map" (a scan-to-map
+  // match when the scan came), "rematch" (one later).
+  const std::string& edge_origin(std::size_t edge) const { return origins_.at(edge); }
+  const ScanGraphConfig& config() const { return config_; }
+
+ private:
+  void add_odometry(std::size_t from, std::size_t to);
+  void match_pairs(std::size_t scan, bool matched_to_map, GraphUpdate& update);
+  std::optional<GraphEdge> match_pair(std::size_t from, std::size_t to) const;
+  MoveUncertainty relative_uncertainty(std::size_t from, std::size_t to) const;
+  void update_anchors(const GraphSolveReport& solve);
+
+  ScanGraphConfig config_;
+  PoseNoise noise_;
+  PoseGraph graph_;
+  std::vector<std::shared_ptr<const PointCloud>> thinned_;  // levelled, per scan
+  std::vector<Pose> reported_;
+  std::vector<std::uint8_t> anchored_;
+  std::vector<MoveUncertainty> uncertain_;  // per scan: of its estimate while not anchored
+  std::map<std::string, std::size_t> last_of_track_;
+  std::vector<std::string> origins_;  // per edge
+  std::vector<std::string> tracks_;   // per scan
+};
+
+}  // namespace scanplan

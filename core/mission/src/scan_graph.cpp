@@ -1,0 +1,273 @@
+#include "scanplan/mission/scan_graph.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <limits>
+
+#include "scanplan/geometry/voxel_filter.hpp"
+
+namespace scanplan {
+namespace {
+
+Eigen::Matrix4d diagonal_information(double sigma_xy_m, double sigma_z_m, double sigma_yaw_rad) {
+  return Eigen::Vector4d(1 / (sigma_xy_m * sigma_xy_m), 1 / (sigma_xy_m * sigma_xy_m),
+                         1 / (sigma_z_m * sigma_z_m), 1 / (sigma_yaw_rad * sigma_yaw_rad))
+      .asDiagonal();
+}
+
+// A match's information as the graph takes it: per unit point variance over σ², plus a prior
+// far weaker than any match (10 m, 10°) so that a direction no surface fixed stays invertible.
+Eigen::Matrix4d match_information(const Eigen::Matrix4d& per_point, double sigma_m) {
+  return per_point / (sigma_m * sigma_m) + diagonal_information(10.0, 10.0, deg2rad(10.0));
+}
+
+}  // namespace
+
+Pose level(Pose pose) {
+  pose.roll = 0;
+  pose.pitch = 0;
+  return pose;
+}
+
+PointCloud levelled(PointCloud scan, const Pose& pose) {
+  const Eigen::Matrix3f tilt = (Eigen::AngleAxisd(pose.pitch, Eigen::Vector3d::UnitY()) *
+                                Eigen::AngleAxisd(pose.roll, Eigen::Vector3d::UnitX()))
+                                   .toRotationMatrix()
+                                   .cast<float>();
+  for (auto& p : scan.points) p = tilt * p;
+  return scan;
+}
+
+RegistrationConfig widened(RegistrationConfig config, const MoveUncertainty& prior) {
+  const double xy = std::min(3 * prior.xy_m, kWidestSearchM);
+  const double yaw = std::min(3 * prior.yaw_deg, kWidestSearchDeg);
+  if (xy <= config.search.xy_range_m && yaw <= config.search.yaw_range_deg) return config;
+  config.search.xy_range_m = std::max(config.search.xy_range_m, xy);
+  config.search.yaw_range_deg = std::max(config.search.yaw_range_deg, yaw);
+  config.search.hypotheses = std::max(config.search.hypotheses, 5);
+  config.search.ambiguity_ratio = 0.8;
+  return config;
+}
+
+MoveUncertainty ScanGraph::odometry_uncertainty(const RelativePose& move) const {
+  if (noise_.model == OdometryModel::kDrift) {
+    // The robot drives around what is in its way: the path is longer than the straight line
+    // between the two reports, and the drift grows with the path.
+    const double d = config_.path_factor * std::hypot(move.x, move.y);
+    return {std::max(noise_.xy_drift_fraction * d, config_.min_odometry_sigma_m),
+            std::max(noise_.z_drift_fraction * d, config_.min_odometry_sigma_m),
+            std::max(noise_.yaw_drift_deg_per_10m * d / 10.0, config_.min_odometry_sigma_deg)};
+  }
+  // Two independent fixes: the difference has twice their variance.
+  return {std::sqrt(2.0) * std::max(noise_.xy_sigma_m, config_.min_odometry_sigma_m),
+          std::sqrt(2.0) * std::max(noise_.z_sigma_m, config_.min_odometry_sigma_m),
+          std::sqrt(2.0) * std::max(noise_.yaw_sigma_deg, config_.min_odometry_sigma_deg)};
+}
+
+std::optional<std::size_t> ScanGraph::last_anchored_of(const std::string& track) const {
+  for (std::size_t i = tracks_.size(); i-- > 0;) {
+    if (tracks_[i] == track && anchored_[i]) return i;
+  }
+  return std::nullopt;
+}
+
+std::optional<MoveUncertainty> ScanGraph::prior_uncertainty(const std::string& track,
+                                                            const Pose& reported) const {
+  const auto from = last_anchored_of(track);
+  if (!from || noise_.model != OdometryModel::kDrift) return std::nullopt;
+  // The robot's reports from that scan on, then `reported`.
+  std::vector<const Pose*> stops;
+  for (std::size_t i = *from; i < tracks_.size(); ++i) {
+    if (tracks_[i] == track) stops.push_back(&reported_[i]);
+  }
+  stops.push_back(&reported);
+  MoveUncertainty u;
+  for (std::size_t s = 1; s < stops.size(); ++s) {
+    const RelativePose move = relative_pose(*stops[s - 1], *stops[s]);
+    const MoveUncertainty m = odometry_uncertainty(move);
+    const double swing = std::hypot(move.x, move.y) * deg2rad(u.yaw_deg);
+    u.xy_m = std::sqrt(u.xy_m * u.xy_m + m.xy_m * m.xy_m + swing * swing);
+    u.z_m = std::hypot(u.z_m, m.z_m);
+    u.yaw_deg = std::hypot(u.yaw_deg, m.yaw_deg);
+  }
+  return u;
+}
+
+ScanGraph::ScanGraph(ScanGraphConfig config, PoseNoise noise)
+    : config_(std::move(config)), noise_(noise), graph_(config_.solver) {}
+
+std::optional<std::size_t> ScanGraph::last_of(const std::string& track) const {
+  const auto it = last_of_track_.find(track);
+  if (it == last_of_track_.end()) return std::nullopt;
+  return it->second;
+}
+
+GraphUpdate ScanGraph::add(const PointCloud& scan, const Placement& where) {
+  const MoveUncertainty uncertain =
+      where.matched ? MoveUncertainty{}
+                    : prior_uncertainty(where.track, where.reported).value_or(MoveUncertainty{});
+  const std::size_t k = graph_.add_node(where.placed);
+  const RegistrationConfig adapted = adapted_config(scan, config_.registration);
+  thinned_.push_back(std::make_shared<const PointCloud>(
+      levelled(voxel_downsample(scan, adapted.voxel_m), where.placed)));
+  reported_.push_back(where.reported);
+  tracks_.push_back(where.track);
+  anchored_.push_back(k == 0 || where.matched ? 1 : 0);
+  uncertain_.push_back(uncertain);
+  if (const auto previous = last_of(where.track)) add_odometry(*previous, k);
+  last_of_track_[where.track] = k;
+
+  GraphUpdate update;
+  match_pairs(k, where.matched, update);
+  if (where.matched) add_match_to_map(k, where.placed, where.information, "map");
+  update.solve = solve();
+  return update;
+}
+
+GraphSolveReport ScanGraph::solve() {
+  GraphSolveReport report = graph_.optimise();
+  update_anchors(report);
+  return report;
+}
+
+void ScanGraph::add_odometry(std::size_t from, std::size_t to) {
+  const RelativePose move = relative_pose(reported_[from], reported_[to]);
+  const MoveUncertainty u = odometry_uncertainty(move);
+  graph_.add_edge({from, to, move, diagonal_information(u.xy_m, u.z_m, deg2rad(u.yaw_deg)),
+                   EdgeKind::kOdometry});
+  origins_.emplace_back("odometry");
+}
+
+// The scan-to-map match placed the scan against the anchored scans around it; the graph has no
+// node for "the map", so the result ties the scan to the nearest anchored scan as the map then
+// had it.
+void ScanGraph::add_match_to_map(std::size_t k, const Pose& placed,
+                                 const Eigen::Matrix4d& information, const char* origin) {
+  std::optional<std::size_t> nearest;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t j = 0; j < graph_.size(); ++j) {
+    if (j == k || !anchored_[j]) continue;
+    const Pose& p = graph_.pose(j);
+    const double d = std::hypot(p.x - placed.x, p.y - placed.y);
+    if (d < best) best = d, nearest = j;
+  }
+  if (!nearest) return;
+  anchored_[k] = 1;
+  uncertain_[k] = MoveUncertainty{};
+  Pose at = placed;  // a levelled match keeps the measured tilt
+  at.roll = graph_.pose(k).roll;
+  at.pitch = graph_.pose(k).pitch;
+  graph_.set_pose(k, at);
+  const Pose& j = graph_.pose(*nearest);
+  graph_.add_edge({*nearest, k, relative_pose(j, placed),
+                   match_information(turned_information(information, j.yaw), config_.match_sigma_m),
+                   EdgeKind::kMatch});
+  origins_.emplace_back(origin);
+}
+
+void ScanGraph::match_pairs(std::size_t k, bool matched_to_map, GraphUpdate& update) {
+  const Pose& at = graph_.pose(k);
+  std::vector<std::pair<double, std::size_t>> near;
+  for (std::size_t j = 0; j < k; ++j) {
+    // The map match already related the scan to every anchored scan around it, and more
+    // accurately than one scan can (more overlap): pairs with those would only add noisier,
+    // correlated copies of it, which bend the graph (a 1 cm sideways error 25 m away turns a
+    // scan by 0.02°). A scan the map does not hold yet is what a pair can tie in.
+    if (matched_to_map && anchored_[j]) continue;
+    const Pose& p = graph_.pose(j);
+    const double d = std::hypot(p.x - at.x, p.y - at.y);
+    if (d <= config_.pair_radius_m) near.emplace_back(d, j);
+  }
+  std::sort(near.begin(), near.end());
+  if (near.size() > config_.max_pairs) near.resize(config_.max_pairs);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (const auto& [d, j] : near) {
+    ++update.pairs_tried;
+    if (const auto edge = match_pair(j, k)) {
+      graph_.add_edge(*edge);
+      origins_.emplace_back(anchored_[j] && anchored_[k] ? "pair" : "pair-search");
+      ++update.pairs_matched;
+      if (!anchored_[k] && anchored_[j]) {
+        // The next pairs start from where this one put the scan, not metres off.
+        const Pose& b = graph_.pose(k);
+        graph_.set_pose(k, compose(graph_.pose(j), edge->measured, b.roll, b.pitch));
+        anchored_[k] = 1;
+      }
+    }
+  }
+  update.match_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// How far off the graph's estimate of `to` seen from `from` may be: a robot's consecutive scans
+// by the move alone (odometry is good over one move, whatever came before), others by what
+// each end's own estimate may be off.
+MoveUncertainty ScanGraph::relative_uncertainty(std::size_t from, std::size_t to) const {
+  for (const GraphEdge& e : graph_.edges()) {
+    if (e.kind == EdgeKind::kOdometry && e.from == from && e.to == to) {
+      return odometry_uncertainty(e.measured);
+    }
+  }
+  const MoveUncertainty& f = uncertain_[from];
+  const MoveUncertainty& t = uncertain_[to];
+  return {std::hypot(f.xy_m, t.xy_m), std::hypot(f.z_m, t.z_m), std::hypot(f.yaw_deg, t.yaw_deg)};
+}
+
+std::optional<GraphEdge> ScanGraph::match_pair(std::size_t from, std::size_t to) const {
+  const Pose a = level(graph_.pose(from));
+  const Pose b = level(graph_.pose(to));
+  const Eigen::Isometry3d initial = a.isometry().inverse() * b.isometry();
+  const bool sure = anchored_[from] && anchored_[to];
+  const MoveUncertainty u = relative_uncertainty(from, to);
+  const RegistrationResult r =
+      sure ? register_scans(*thinned_[from], *thinned_[to], initial, Method::kGicp,
+                            config_.registration)
+           : register_scans(*thinned_[from], *thinned_[to], initial, Method::kSearchGicp,
+                            widened(config_.registration, u));
+  if (!r.converged) return std::nullopt;
+  // How far the result is from where the graph had the pair, in `from`'s levelled frame (the
+  // clouds are levelled: the transform is the relative pose itself).
+  const RelativePose was = relative_pose(a, b), now = relative_pose(a, r.transform);
+  const double shift = std::hypot(now.x - was.x, now.y - was.y, now.z - was.z);
+  const double turn = std::abs(rad2deg(std::remainder(now.yaw - was.yaw, 2 * M_PI)));
+  const double reach_m =
+      std::max(config_.max_search_shift_m,
+               std::min(3 * std::sqrt(2.0) * u.xy_m, std::sqrt(2.0) * kWidestSearchM));
+  const double reach_deg =
+      std::max(config_.max_search_turn_deg, std::min(3 * u.yaw_deg, kWidestSearchDeg));
+  if (shift > (sure ? config_.max_pair_shift_m : reach_m) ||
+      turn > (sure ? config_.max_pair_turn_deg : reach_deg)) {
+    return std::nullopt;
+  }
+  return GraphEdge{from, to, now, match_information(r.information, config_.pair_sigma_m),
+                   EdgeKind::kMatch};
+}
+
+void ScanGraph::update_anchors(const GraphSolveReport& solve) {
+  std::vector<std::uint8_t> outlier(graph_.edges().size(), 0);
+  for (const std::size_t e : solve.outliers) outlier[e] = 1;
+  std::vector<std::vector<std::size_t>> next(graph_.size());
+  for (std::size_t e = 0; e < graph_.edges().size(); ++e) {
+    const GraphEdge& edge = graph_.edges()[e];
+    if (edge.kind != EdgeKind::kMatch || outlier[e]) continue;
+    next[edge.from].push_back(edge.to);
+    next[edge.to].push_back(edge.from);
+  }
+  std::fill(anchored_.begin(), anchored_.end(), 0);
+  std::deque<std::size_t> queue{0};
+  anchored_[0] = 1;
+  while (!queue.empty()) {
+    const std::size_t i = queue.front();
+    queue.pop_front();
+    for (const std::size_t j : next[i]) {
+      if (!anchored_[j]) anchored_[j] = 1, queue.push_back(j);
+    }
+  }
+  for (std::size_t i = 0; i < anchored_.size(); ++i) {
+    if (anchored_[i]) uncertain_[i] = MoveUncertainty{};
+  }
+}
+
+}  // namespace scanplan
