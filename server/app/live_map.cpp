@@ -13,8 +13,20 @@
 
 namespace scanplan::server {
 
+namespace {
+
+// The server keeps its own copies of what the pipeline places (points per scan, Draco chunks,
+// the stored poses); until those follow the pose graph's corrections, its scans stay where the
+// map match put them, as before the graph.
+MissionConfig without_graph(MissionConfig config) {
+  config.graph.reset();
+  return config;
+}
+
+}  // namespace
+
 LiveMap::LiveMap(PlanBook& plans, MissionConfig config)
-    : mission_(std::move(config)),
+    : mission_(without_graph(std::move(config))),
       sensor_height_m_(mission_.config().mapping.sensor_height_m),
       plans_(plans),
       claim_separation_m_(mission_.planner().claim_separation_m),

@@ -19,14 +19,13 @@ PoseChange change(const Pose& a, const Pose& b) {
           std::abs(rad2deg(std::remainder(b.yaw - a.yaw, 2 * M_PI)))};
 }
 
-// `config` reaching as far as the pose it starts from may be off (ScanGraph's uncertainty).
+// `config` searching as far as the pose it starts from may be off (ScanGraph's uncertainty),
+// so that a look-alike farther out shows the match to be ambiguous. The correction it may
+// apply stays the pose sensors' own (MapMatchConfig::max_correction_m): on the campus, the
+// corrections beyond it that the wider search found were right 11 times and wrong twice, each
+// time by one building's depth (16 m), and a scan placed inside a building ends the mission.
 MapMatchConfig widened(MapMatchConfig config, const MoveUncertainty& prior) {
   config.registration = widened(config.registration, prior);
-  config.max_correction_m =
-      std::max(config.max_correction_m,
-               std::min(3 * std::sqrt(2.0) * prior.xy_m, std::sqrt(2.0) * kWidestSearchM));
-  config.max_correction_deg =
-      std::max(config.max_correction_deg, std::min(3 * prior.yaw_deg, kWidestSearchDeg));
   return config;
 }
 
@@ -246,8 +245,21 @@ void MissionPipeline::replace() {
 std::vector<FleetPlan> MissionPipeline::plan(const std::vector<FleetRobot>& robots,
                                              std::vector<Eigen::Vector3d> claimed) const {
   if (!has_map()) return {};
+  for (const Eigen::Vector3d& p : unplaced_scan_points()) claimed.push_back(p);
   return plan_fleet(mapping_.map(), *mapping_.target(), mapping_.scan_points(), robots,
                     std::move(claimed), config_.planner, anchored_map());
+}
+
+// Where the scans the map does not hold were taken, as the graph has them: the planner counts
+// what they saw as scanned and sends no robot right back there (a scan taken again where one
+// could not be placed would most likely fail the same way); a scan around them later ties them
+// in. Roughly placed, but metres matter little to that.
+std::vector<Eigen::Vector3d> MissionPipeline::unplaced_scan_points() const {
+  std::vector<Eigen::Vector3d> out;
+  for (std::size_t i = 0; i < poses_.size(); ++i) {
+    if (!in_map_[i]) out.emplace_back(poses_[i].x, poses_[i].y, poses_[i].z);
+  }
+  return out;
 }
 
 Plan MissionPipeline::plan_from(const Eigen::Vector3d& robot, std::uint64_t seed) const {
@@ -257,6 +269,8 @@ Plan MissionPipeline::plan_from(const Eigen::Vector3d& robot, std::uint64_t seed
   const std::vector<Eigen::Vector2d> points = mapping_.scan_points();
   PlanInput in{mapping_.map(), *mapping_.target(), points, robot};
   in.anchored = anchored_map();
+  const std::vector<Eigen::Vector3d> unplaced = unplaced_scan_points();
+  if (!unplaced.empty()) in.claimed = &unplaced;
   return plan_next_scan(in, planner);
 }
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <deque>
 #include <limits>
 
 #include "scanplan/geometry/voxel_filter.hpp"
@@ -116,6 +115,7 @@ GraphUpdate ScanGraph::add(const PointCloud& scan, const Placement& where) {
   tracks_.push_back(where.track);
   anchored_.push_back(k == 0 || where.matched ? 1 : 0);
   uncertain_.push_back(uncertain);
+  pending_.emplace_back();
   if (const auto previous = last_of(where.track)) add_odometry(*previous, k);
   last_of_track_[where.track] = k;
 
@@ -138,6 +138,7 @@ void ScanGraph::add_odometry(std::size_t from, std::size_t to) {
   graph_.add_edge({from, to, move, diagonal_information(u.xy_m, u.z_m, deg2rad(u.yaw_deg)),
                    EdgeKind::kOdometry});
   origins_.emplace_back("odometry");
+  anchors_.push_back(kNoNode);
 }
 
 // The scan-to-map match placed the scan against the anchored scans around it; the graph has no
@@ -161,10 +162,11 @@ void ScanGraph::add_match_to_map(std::size_t k, const Pose& placed,
   at.pitch = graph_.pose(k).pitch;
   graph_.set_pose(k, at);
   const Pose& j = graph_.pose(*nearest);
-  graph_.add_edge({*nearest, k, relative_pose(j, placed),
-                   match_information(turned_information(information, j.yaw), config_.match_sigma_m),
-                   EdgeKind::kMatch});
-  origins_.emplace_back(origin);
+  add_match_edge({*nearest, k, relative_pose(j, placed),
+                  match_information(turned_information(information, j.yaw), config_.match_sigma_m),
+                  EdgeKind::kMatch},
+                 origin, k);
+  pending_[k].clear();
 }
 
 void ScanGraph::match_pairs(std::size_t k, bool matched_to_map, GraphUpdate& update) {
@@ -185,16 +187,15 @@ void ScanGraph::match_pairs(std::size_t k, bool matched_to_map, GraphUpdate& upd
   const auto t0 = std::chrono::steady_clock::now();
   for (const auto& [d, j] : near) {
     ++update.pairs_tried;
-    if (const auto edge = match_pair(j, k)) {
-      graph_.add_edge(*edge);
-      origins_.emplace_back(anchored_[j] && anchored_[k] ? "pair" : "pair-search");
-      ++update.pairs_matched;
-      if (!anchored_[k] && anchored_[j]) {
-        // The next pairs start from where this one put the scan, not metres off.
-        const Pose& b = graph_.pose(k);
-        graph_.set_pose(k, compose(graph_.pose(j), edge->measured, b.roll, b.pitch));
-        anchored_[k] = 1;
-      }
+    const auto edge = match_pair(j, k);
+    if (!edge) continue;
+    ++update.pairs_matched;
+    if (anchored_[j] == anchored_[k]) {
+      // Two scans neither of which the map holds: their chain floats together until one is
+      // tied in (anchors nothing).
+      add_match_edge(*edge, "pair-search", kNoNode);
+    } else {
+      offer(*edge, anchored_[j] ? k : j);
     }
   }
   update.match_ms =
@@ -219,26 +220,17 @@ std::optional<GraphEdge> ScanGraph::match_pair(std::size_t from, std::size_t to)
   const Pose a = level(graph_.pose(from));
   const Pose b = level(graph_.pose(to));
   const Eigen::Isometry3d initial = a.isometry().inverse() * b.isometry();
-  const bool sure = anchored_[from] && anchored_[to];
-  const MoveUncertainty u = relative_uncertainty(from, to);
+  // One end is not anchored (match_pairs): where it lies may be metres off.
   const RegistrationResult r =
-      sure ? register_scans(*thinned_[from], *thinned_[to], initial, Method::kGicp,
-                            config_.registration)
-           : register_scans(*thinned_[from], *thinned_[to], initial, Method::kSearchGicp,
-                            widened(config_.registration, u));
+      register_scans(*thinned_[from], *thinned_[to], initial, Method::kSearchGicp,
+                     widened(config_.registration, relative_uncertainty(from, to)));
   if (!r.converged) return std::nullopt;
   // How far the result is from where the graph had the pair, in `from`'s levelled frame (the
   // clouds are levelled: the transform is the relative pose itself).
   const RelativePose was = relative_pose(a, b), now = relative_pose(a, r.transform);
   const double shift = std::hypot(now.x - was.x, now.y - was.y, now.z - was.z);
   const double turn = std::abs(rad2deg(std::remainder(now.yaw - was.yaw, 2 * M_PI)));
-  const double reach_m =
-      std::max(config_.max_search_shift_m,
-               std::min(3 * std::sqrt(2.0) * u.xy_m, std::sqrt(2.0) * kWidestSearchM));
-  const double reach_deg =
-      std::max(config_.max_search_turn_deg, std::min(3 * u.yaw_deg, kWidestSearchDeg));
-  if (shift > (sure ? config_.max_pair_shift_m : reach_m) ||
-      turn > (sure ? config_.max_pair_turn_deg : reach_deg)) {
+  if (shift > config_.max_search_shift_m || turn > config_.max_search_turn_deg) {
     return std::nullopt;
   }
   return GraphEdge{from, to, now, match_information(r.information, config_.pair_sigma_m),
@@ -248,26 +240,66 @@ std::optional<GraphEdge> ScanGraph::match_pair(std::size_t from, std::size_t to)
 void ScanGraph::update_anchors(const GraphSolveReport& solve) {
   std::vector<std::uint8_t> outlier(graph_.edges().size(), 0);
   for (const std::size_t e : solve.outliers) outlier[e] = 1;
-  std::vector<std::vector<std::size_t>> next(graph_.size());
-  for (std::size_t e = 0; e < graph_.edges().size(); ++e) {
-    const GraphEdge& edge = graph_.edges()[e];
-    if (edge.kind != EdgeKind::kMatch || outlier[e]) continue;
-    next[edge.from].push_back(edge.to);
-    next[edge.to].push_back(edge.from);
-  }
   std::fill(anchored_.begin(), anchored_.end(), 0);
-  std::deque<std::size_t> queue{0};
   anchored_[0] = 1;
-  while (!queue.empty()) {
-    const std::size_t i = queue.front();
-    queue.pop_front();
-    for (const std::size_t j : next[i]) {
-      if (!anchored_[j]) anchored_[j] = 1, queue.push_back(j);
-    }
+  for (std::size_t e = 0; e < graph_.edges().size(); ++e) {
+    if (anchors_[e] != kNoNode && !outlier[e]) anchored_[anchors_[e]] = 1;
   }
   for (std::size_t i = 0; i < anchored_.size(); ++i) {
     if (anchored_[i]) uncertain_[i] = MoveUncertainty{};
   }
+}
+
+void ScanGraph::add_match_edge(const GraphEdge& edge, const char* origin, std::size_t anchors) {
+  graph_.add_edge(edge);
+  origins_.emplace_back(origin);
+  anchors_.push_back(anchors);
+}
+
+// Where `edge` puts its end `scan` from the other end's current estimate.
+Pose ScanGraph::implied(const GraphEdge& edge, std::size_t scan) const {
+  const Pose& at = graph_.pose(scan);
+  if (scan == edge.to) return compose(graph_.pose(edge.from), edge.measured, at.roll, at.pitch);
+  Pose relative;
+  relative.x = edge.measured.x;
+  relative.y = edge.measured.y;
+  relative.z = edge.measured.z;
+  relative.yaw = edge.measured.yaw;
+  Pose from =
+      Pose::from_isometry(level(graph_.pose(edge.to)).isometry() * relative.isometry().inverse());
+  from.roll = at.roll;
+  from.pitch = at.pitch;
+  return from;
+}
+
+// A pairwise match with an anchored scan ties `scan` in only when a second one, with another
+// anchored scan, puts it in the same place: one match found in a repeated structure (the far
+// face of a building as deep as the search is wide) would otherwise bring a scan into the map
+// metres off, and the map never recovers from a phantom wall. Until then the result waits.
+void ScanGraph::offer(const GraphEdge& edge, std::size_t scan) {
+  const Pose there = implied(edge, scan);
+  std::vector<GraphEdge>& waiting = pending_[scan];
+  std::vector<GraphEdge> agreeing;
+  for (const GraphEdge& other : waiting) {
+    const std::size_t other_end = other.from == scan ? other.to : other.from;
+    const std::size_t this_end = edge.from == scan ? edge.to : edge.from;
+    if (other_end == this_end) continue;
+    const Pose p = implied(other, scan);
+    if (std::hypot(p.x - there.x, p.y - there.y, p.z - there.z) <= config_.agree_m &&
+        std::abs(rad2deg(std::remainder(p.yaw - there.yaw, 2 * M_PI))) <= config_.agree_deg) {
+      agreeing.push_back(other);
+    }
+  }
+  if (agreeing.empty()) {
+    waiting.push_back(edge);
+    return;
+  }
+  graph_.set_pose(scan, there);
+  anchored_[scan] = 1;
+  uncertain_[scan] = MoveUncertainty{};
+  add_match_edge(edge, "pair-search", scan);
+  for (const GraphEdge& other : agreeing) add_match_edge(other, "pair-search", scan);
+  waiting.clear();
 }
 
 }  // namespace scanplan

@@ -101,23 +101,35 @@ TEST_F(MissionPipelineTest, OnlyAnchoredScansAreMatchedAgainst) {
             mission.points_near(off.x, off.y, in->config.target_radius_m, true).size());
 }
 
-// With the graph, the refused scan is matched with the first pairwise (their relative pose is
-// known to the odometry's accuracy), joins the map at its true pose, and is anchored.
+// With the graph, a scan the map match refused is matched pairwise with the anchored scans
+// around it; one pair alone could be a look-alike, two that agree tie it in at its true pose.
 TEST_F(MissionPipelineTest, TheGraphPlacesAScanTheMapMatchRefused) {
   MissionPipeline mission(config());
   mission.add(scan_at(at(-15, -8, 0), 1), {at(-15, -8, 0), at(-15, -8, 0)});
   Placement refused(at(-3, -7, 0), at(-3, -7, 0));  // 2 m off, as a refused match leaves it
-  const PointCloud second = scan_at(at(-5, -9, 0), 2);
-  mission.add(second, refused);
+  mission.add(scan_at(at(-5, -9, 0), 2), refused);
+  EXPECT_FALSE(mission.anchored(1)) << "one pairwise match is not enough";
+  EXPECT_FALSE(mission.in_map(1));
+  ASSERT_TRUE(mission.last_correction());
+  EXPECT_EQ(mission.last_correction()->graph.pairs_matched, 1u);
+
+  // A third scan, placed by the map match, agrees on where the second lies.
+  const Pose third = at(-12, 4, 30);
+  const PointCloud third_scan = scan_at(third, 3);
+  const auto m = mission.place(third_scan, third);
+  ASSERT_TRUE(m && m->applied);
+  Placement matched(third, m->placed, true);
+  matched.information = m->information;
+  mission.add(third_scan, matched);
   EXPECT_TRUE(mission.anchored(1));
   EXPECT_TRUE(mission.in_map(1));
   EXPECT_NEAR(mission.poses()[1].x, -5, 0.03);
   EXPECT_NEAR(mission.poses()[1].y, -9, 0.03);
   ASSERT_TRUE(mission.last_correction());
-  EXPECT_EQ(mission.last_correction()->graph.pairs_matched, 1u);
   EXPECT_EQ(mission.last_correction()->moved, std::vector<std::size_t>{1});
   EXPECT_NEAR(mission.last_correction()->max_moved_m, std::hypot(2.0, 2.0), 0.05);
   // Its points in the map moved with it.
+  const PointCloud second = scan_at(at(-5, -9, 0), 2);
   const Eigen::Vector3f moved = mission.poses()[1].isometry().cast<float>() * second.points[0];
   EXPECT_LT((mission.placed_scans()[1]->points[0] - moved).norm(), 1e-3);
 }

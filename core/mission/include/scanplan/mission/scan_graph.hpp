@@ -22,17 +22,17 @@ struct ScanGraphConfig {
   // range share too little to be worth the time (the planner spaces scans 30–40 m).
   double pair_radius_m = 45.0;
   std::size_t max_pairs = 6;
-  // The pairwise match: GICP from where the graph puts the two scans when both are anchored
-  // (their relative pose is already good to centimetres), else the search over the pose
-  // sensors' uncertainty first.
+  // The pairwise match: the search over how far off the scan not anchored may be, then GICP
+  // (search-gicp), on the scans thinned and levelled.
   RegistrationConfig registration;
-  // Between two anchored scans a pairwise result farther than this from their current relative
-  // pose is not believed: the graph already knows it that well.
-  double max_pair_shift_m = 1.0;
-  double max_pair_turn_deg = 3.0;
-  // Between scans of which one is not anchored: the pose sensors' reach (MapMatchConfig).
+  // A pairwise result farther than this from where the graph had the pair is not believed
+  // however far the search looked (see widened()): the pose sensors' usual reach
+  // (MapMatchConfig::max_correction_m).
   double max_search_shift_m = 6.0;
   double max_search_turn_deg = 25.0;
+  // Two pairwise matches agree on where a scan lies when their results are this close.
+  double agree_m = 0.10;
+  double agree_deg = 0.2;
   // σ of one point-to-plane distance in a match (the scanner's range noise is 1 cm):
   // AlignmentQuality::information / σ² is a match edge's information.
   double match_sigma_m = 0.01;
@@ -63,12 +63,11 @@ struct MoveUncertainty {
 
 // `config` whose search reaches 3σ of `prior` where that is wider than it already is
 // (scan-to-map matching and the pairwise search alike): a robot that drove 150 m on 2 %
-// odometry may be 9 m off, beyond the 6 m its GNSS-like fixes never exceed. The weak-evidence
-// limit (restart_max_shift_m) stays: far from where the sensors put it, only a match that fixes
-// the pose firmly is believed. Widened, the search looks at more peaks and refuses a fit that
+// odometry may be 9 m off. Widened, the search looks at more peaks and refuses a fit that
 // another distinct pose matches almost as well (PoseSearchConfig::ambiguity_ratio): the wider
-// the search, the likelier it spans a repeated structure. It never reaches beyond
-// kWidestSearchM / _Deg, where a scan is better left to the graph than matched to a look-alike.
+// the search, the likelier it spans a repeated structure, and a match that another pose farther
+// out fits as well is not believed. It never reaches beyond kWidestSearchM / _Deg. The
+// correction applied stays within the sensors' usual reach (the callers' limits).
 inline constexpr double kWidestSearchM = 10.0;
 inline constexpr double kWidestSearchDeg = 45.0;
 RegistrationConfig widened(RegistrationConfig config, const MoveUncertainty& prior);
@@ -102,7 +101,9 @@ class ScanGraph {
 
   std::size_t size() const { return graph_.size(); }
   const std::vector<Pose>& poses() const { return graph_.poses(); }
-  // Whether believed matches (not outliers) tie the scan to the first one.
+  // Whether the scan is tied into the map: the first, one a believed map match placed (when it
+  // came or later), or one two agreeing pairwise matches with anchored scans placed; and the
+  // edge that did it not set aside as an outlier.
   bool anchored(std::size_t scan) const { return anchored_.at(scan) != 0; }
   // The latest scan of a robot, if any.
   std::optional<std::size_t> last_of(const std::string& track) const;
@@ -122,9 +123,9 @@ class ScanGraph {
   // does).
   const MoveUncertainty& uncertainty(std::size_t scan) const { return uncertain_.at(scan); }
   const PoseGraph& graph() const { return graph_; }
-  // How each edge of graph() came about, by index: "odometry", "pair" (GICP between anchored
-  // scans), "pair-search" (the search first: one end was not anchored), "map" (a scan-to-map
-  // match when the scan came), "rematch" (one later).
+  // How each edge of graph() came about, by index: "odometry", "pair-search" (a pairwise match,
+  // the search first: one end was not anchored), "map" (a scan-to-map match when the scan came),
+  // "rematch" (one later).
   const std::string& edge_origin(std::size_t edge) const { return origins_.at(edge); }
   const ScanGraphConfig& config() const { return config_; }
 
@@ -134,6 +135,10 @@ class ScanGraph {
   std::optional<GraphEdge> match_pair(std::size_t from, std::size_t to) const;
   MoveUncertainty relative_uncertainty(std::size_t from, std::size_t to) const;
   void update_anchors(const GraphSolveReport& solve);
+  static constexpr std::size_t kNoNode = static_cast<std::size_t>(-1);
+  void add_match_edge(const GraphEdge& edge, const char* origin, std::size_t anchors);
+  void offer(const GraphEdge& edge, std::size_t scan);
+  Pose implied(const GraphEdge& edge, std::size_t scan) const;
 
   ScanGraphConfig config_;
   PoseNoise noise_;
@@ -144,7 +149,10 @@ class ScanGraph {
   std::vector<MoveUncertainty> uncertain_;  // per scan: of its estimate while not anchored
   std::map<std::string, std::size_t> last_of_track_;
   std::vector<std::string> origins_;  // per edge
-  std::vector<std::string> tracks_;   // per scan
+  std::vector<std::size_t> anchors_;  // per edge: the scan it ties into the map, or kNoNode
+  // Per scan not anchored: pairwise results with anchored scans waiting for one that agrees.
+  std::vector<std::vector<GraphEdge>> pending_;
+  std::vector<std::string> tracks_;  // per scan
 };
 
 }  // namespace scanplan
