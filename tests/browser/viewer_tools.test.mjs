@@ -238,8 +238,9 @@ test('annotations: placed on the map, stored, shown to others', { timeout: 60000
     await page.locator(`#annot-list li[data-id="${mine.id}"] .annot-delete`).click();
     await page.waitForSelector('#confirm[open]');
     await page.click('#confirm-ok');
+    // Each page learns of it from its own event stream, in its own time.
     await waitForData(viewer.page, 'the withdrawal to reach the viewer', (id) => !window.scanplan.annotations.items.has(id), mine.id);
-    assert.ok(!(await page.evaluate((id) => window.scanplan.annotations.items.has(id), mine.id)));
+    await waitForData(page, 'the withdrawal to reach the operator', (id) => !window.scanplan.annotations.items.has(id), mine.id);
     assert.deepEqual(operator.problems.pageErrors, []);
     assert.deepEqual(viewer.problems.pageErrors, []);
   });

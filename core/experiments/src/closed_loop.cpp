@@ -205,9 +205,13 @@ LoopResult run_closed_loop(
     const bool last = scan == config.max_scans || step.coverage_pct >= config.stop_at_coverage_pct;
     if (!last) {
       const auto t0 = std::chrono::steady_clock::now();
-      const Plan plan =
-          mission.plan_from({step.placed_pose.x, step.placed_pose.y, step.placed_pose.z},
-                            config.planner.seed * 1000003u + static_cast<std::uint64_t>(scan));
+      // Where the map knows the robot to be: its latest scan, or, when that one could not be
+      // placed (it waits outside the map, perhaps metres off), the latest the map holds.
+      const Pose& at = mission.in_map(mission.poses().size() - 1)
+                           ? step.placed_pose
+                           : pipeline.scan_poses().back();
+      const Plan plan = mission.plan_from(
+          {at.x, at.y, at.z}, config.planner.seed * 1000003u + static_cast<std::uint64_t>(scan));
       step.plan_ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       step.candidates = plan.ranked;

@@ -19,13 +19,20 @@ PoseChange change(const Pose& a, const Pose& b) {
           std::abs(rad2deg(std::remainder(b.yaw - a.yaw, 2 * M_PI)))};
 }
 
-// `config` searching as far as the pose it starts from may be off (ScanGraph's uncertainty),
-// so that a look-alike farther out shows the match to be ambiguous. The correction it may
-// apply stays the pose sensors' own (MapMatchConfig::max_correction_m): on the campus, the
-// corrections beyond it that the wider search found were right 11 times and wrong twice, each
-// time by one building's depth (16 m), and a scan placed inside a building ends the mission.
-MapMatchConfig widened(MapMatchConfig config, const MoveUncertainty& prior) {
+// `config` searching, and correcting, as far as the pose it starts from may be off
+// (ScanGraph's uncertainty). A correction beyond the pose sensors' usual reach is not applied
+// as it stands (beyond_reach; ScanGraph::add's `tentative`): on the campus such corrections were
+// right 11 times and wrong twice, each time by one building's depth (16 m), and a scan placed
+// inside a building ends the mission.
+MapMatchConfig widened(MapMatchConfig config, const MoveUncertainty& prior,
+                       bool correct_as_far = true) {
   config.registration = widened(config.registration, prior);
+  if (!correct_as_far) return config;
+  config.max_correction_m =
+      std::max(config.max_correction_m,
+               std::min(3 * std::sqrt(2.0) * prior.xy_m, std::sqrt(2.0) * kWidestSearchM));
+  config.max_correction_deg =
+      std::max(config.max_correction_deg, std::min(3 * prior.yaw_deg, kWidestSearchDeg));
   return config;
 }
 
@@ -119,7 +126,7 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
     return;
   }
   const std::vector<Pose> before = poses_;
-  GraphUpdate update = graph_->add(scan, where);
+  GraphUpdate update = graph_->add(scan, where, where.matched && beyond_reach(where));
   follow_graph();
   if (rematch_refused(update)) follow_graph();
   last_correction_ = correction(update, before);
@@ -146,6 +153,15 @@ PointCloud MissionPipeline::own_frame(std::size_t i) const {
     own.push_back(own_from_map * in_map.points[p], in_map.colors[p]);
   }
   return own;
+}
+
+// Whether a match moved the scan from where matching started farther than the pose sensors
+// usually err (MapMatchConfig::max_correction_m / _deg): the search reached that far only
+// because the robot drove far since its last anchored scan (match_input).
+bool MissionPipeline::beyond_reach(const Placement& where) const {
+  const PoseChange d = change(prior(where.reported, where.track), where.placed);
+  return d.metres > config_.matching->max_correction_m ||
+         d.degrees > config_.matching->max_correction_deg;
 }
 
 // A scan the map matcher refused when it came may match once more of the map is anchored

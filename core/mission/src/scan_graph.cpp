@@ -103,27 +103,65 @@ std::optional<std::size_t> ScanGraph::last_of(const std::string& track) const {
   return it->second;
 }
 
-GraphUpdate ScanGraph::add(const PointCloud& scan, const Placement& where) {
+GraphUpdate ScanGraph::add(const PointCloud& scan, const Placement& where, bool tentative) {
   const MoveUncertainty uncertain =
-      where.matched ? MoveUncertainty{}
-                    : prior_uncertainty(where.track, where.reported).value_or(MoveUncertainty{});
+      where.matched && !tentative
+          ? MoveUncertainty{}
+          : prior_uncertainty(where.track, where.reported).value_or(MoveUncertainty{});
   const std::size_t k = graph_.add_node(where.placed);
   const RegistrationConfig adapted = adapted_config(scan, config_.registration);
   thinned_.push_back(std::make_shared<const PointCloud>(
       levelled(voxel_downsample(scan, adapted.voxel_m), where.placed)));
   reported_.push_back(where.reported);
   tracks_.push_back(where.track);
-  anchored_.push_back(k == 0 || where.matched ? 1 : 0);
+  const bool matched = where.matched && !tentative;
+  anchored_.push_back(k == 0 || matched ? 1 : 0);
   uncertain_.push_back(uncertain);
   pending_.emplace_back();
-  if (const auto previous = last_of(where.track)) add_odometry(*previous, k);
+  pending_map_.emplace_back();
+  const std::optional<std::size_t> previous = last_of(where.track);
+  previous_.push_back(previous.value_or(kNoNode));
+  if (previous) add_odometry(*previous, k);
   last_of_track_[where.track] = k;
 
   GraphUpdate update;
-  match_pairs(k, where.matched, update);
-  if (where.matched) add_match_to_map(k, where.placed, where.information, "map");
+  match_pairs(k, matched, update);
+  if (matched) add_match_to_map(k, where.placed, where.information, "map");
+  if (where.matched && tentative) pending_map_[k] = MapCandidate{where.placed, where.information};
+  confirm_by_odometry(k);
   update.solve = solve();
   return update;
+}
+
+// Whether `b` placed at `b_placed` lies where the robot's odometry puts it from `a` placed at
+// `a_placed`, within three of the move's σ (at least 0.5 m and 1°).
+bool ScanGraph::odometry_agrees(std::size_t a, const Pose& a_placed, std::size_t b,
+                                const Pose& b_placed) const {
+  const RelativePose move = relative_pose(reported_[a], reported_[b]);
+  const Pose predicted = compose(a_placed, move, b_placed.roll, b_placed.pitch);
+  const MoveUncertainty u = odometry_uncertainty(move);
+  const double off_m = std::hypot(predicted.x - b_placed.x, predicted.y - b_placed.y);
+  const double off_deg = std::abs(rad2deg(std::remainder(predicted.yaw - b_placed.yaw, 2 * M_PI)));
+  return off_m <= std::max(0.5, 3 * std::sqrt(2.0) * u.xy_m) &&
+         off_deg <= std::max(1.0, 3 * u.yaw_deg);
+}
+
+// A map match that corrected the pose further than the sensors usually err (the search reached
+// farther because the robot drove far since its last anchored scan) is believed only when the
+// robot's previous scan, also corrected that far by its own map match, lies where the odometry
+// between the two says: both then carry the same drift, which a look-alike found in a repeated structure would
+// not (it lies one building's depth off for one scan, elsewhere for the other).
+void ScanGraph::confirm_by_odometry(std::size_t k) {
+  // Both far corrections, each its own map match: the robot's anchored scans say nothing here,
+  // since matching started from them and the odometry.
+  const std::size_t p = previous_[k];
+  if (p == kNoNode || !pending_map_[p] || !pending_map_[k]) return;
+  if (!odometry_agrees(p, pending_map_[p]->placed, k, pending_map_[k]->placed)) return;
+  for (const std::size_t i : {p, k}) {
+    const MapCandidate c = *pending_map_[i];
+    pending_map_[i].reset();
+    add_match_to_map(i, c.placed, c.information, "map-confirmed");
+  }
 }
 
 GraphSolveReport ScanGraph::solve() {

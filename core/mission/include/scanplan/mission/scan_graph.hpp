@@ -91,7 +91,10 @@ class ScanGraph {
   ScanGraph(ScanGraphConfig config, PoseNoise noise);
 
   // Scan `scan` (own frame) joins at `where`; its pairs are matched and the graph optimised.
-  GraphUpdate add(const PointCloud& scan, const Placement& where);
+  // `tentative`: where.matched, but the match corrected the pose further than the sensors
+  // usually err; it ties the scan in once the odometry to the robot's next or previous scan
+  // agrees (confirm_by_odometry).
+  GraphUpdate add(const PointCloud& scan, const Placement& where, bool tentative = false);
   // A scan not anchored so far was matched to the map after all (MapMatch::placed and
   // ::information): it is tied to the anchored scan nearest to where the match put it. Call
   // solve() after.
@@ -125,7 +128,8 @@ class ScanGraph {
   const PoseGraph& graph() const { return graph_; }
   // How each edge of graph() came about, by index: "odometry", "pair-search" (a pairwise match,
   // the search first: one end was not anchored), "map" (a scan-to-map match when the scan came),
-  // "rematch" (one later).
+  // "map-confirmed" (one beyond the sensors' reach, confirmed by the odometry to the robot's
+  // next or previous scan), "rematch" (one later).
   const std::string& edge_origin(std::size_t edge) const { return origins_.at(edge); }
   const ScanGraphConfig& config() const { return config_; }
 
@@ -138,6 +142,9 @@ class ScanGraph {
   static constexpr std::size_t kNoNode = static_cast<std::size_t>(-1);
   void add_match_edge(const GraphEdge& edge, const char* origin, std::size_t anchors);
   void offer(const GraphEdge& edge, std::size_t scan);
+  bool odometry_agrees(std::size_t a, const Pose& a_placed, std::size_t b,
+                       const Pose& b_placed) const;
+  void confirm_by_odometry(std::size_t scan);
   Pose implied(const GraphEdge& edge, std::size_t scan) const;
 
   ScanGraphConfig config_;
@@ -152,7 +159,14 @@ class ScanGraph {
   std::vector<std::size_t> anchors_;  // per edge: the scan it ties into the map, or kNoNode
   // Per scan not anchored: pairwise results with anchored scans waiting for one that agrees.
   std::vector<std::vector<GraphEdge>> pending_;
-  std::vector<std::string> tracks_;  // per scan
+  // Per scan: a map match beyond the sensors' usual reach, waiting for the odometry to agree.
+  struct MapCandidate {
+    Pose placed;
+    Eigen::Matrix4d information;
+  };
+  std::vector<std::optional<MapCandidate>> pending_map_;
+  std::vector<std::size_t> previous_;  // per scan: the robot's scan before it, or kNoNode
+  std::vector<std::string> tracks_;    // per scan
 };
 
 }  // namespace scanplan

@@ -1,0 +1,104 @@
+// The scan graph's bookkeeping, without point clouds worth matching: how far the search reaches,
+// how sure odometry is, and when a match beyond the sensors' usual reach is believed.
+#include "scanplan/mission/scan_graph.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace scanplan {
+namespace {
+
+Pose at(double x, double y, double yaw_deg) {
+  Pose p;
+  p.x = x;
+  p.y = y;
+  p.yaw = deg2rad(yaw_deg);
+  return p;
+}
+
+PoseNoise drift() {
+  PoseNoise n;
+  n.model = OdometryModel::kDrift;
+  return n;
+}
+
+// Too few points for any match: only odometry and the placements given relate these scans.
+PointCloud few_points() {
+  PointCloud c;
+  for (int i = 0; i < 10; ++i) c.push_back({static_cast<float>(i), 2.0f, 0.5f}, {1, 2, 3});
+  return c;
+}
+
+Placement placement(const Pose& reported, const Pose& placed, bool matched) {
+  Placement p(reported, placed, matched);
+  p.track = "robot1";
+  if (matched) p.information = Eigen::Matrix4d::Identity() * 0.3;
+  return p;
+}
+
+TEST(ScanGraph, TheSearchWidensWithTheUncertaintyButNotWithoutBound) {
+  const RegistrationConfig base;
+  const RegistrationConfig same = widened(base, {1.0, 0.1, 3.0});
+  EXPECT_EQ(same.search.xy_range_m, base.search.xy_range_m);
+  EXPECT_EQ(same.search.ambiguity_ratio, 0.0);
+
+  const RegistrationConfig wide = widened(base, {3.0, 0.1, 2.0});
+  EXPECT_DOUBLE_EQ(wide.search.xy_range_m, 9.0);
+  EXPECT_DOUBLE_EQ(wide.search.yaw_range_deg, base.search.yaw_range_deg);
+  EXPECT_GE(wide.search.hypotheses, 5);
+  EXPECT_GT(wide.search.ambiguity_ratio, 0.0) << "a wider search may span a look-alike";
+
+  const RegistrationConfig widest = widened(base, {50.0, 1.0, 40.0});
+  EXPECT_DOUBLE_EQ(widest.search.xy_range_m, kWidestSearchM);
+  EXPECT_DOUBLE_EQ(widest.search.yaw_range_deg, kWidestSearchDeg);
+}
+
+TEST(ScanGraph, OdometryIsAsSureAsTheDriftModelSays) {
+  const ScanGraph drifting({}, drift());
+  const MoveUncertainty u = drifting.odometry_uncertainty({20, 0, 0, 0});
+  EXPECT_NEAR(u.xy_m, 0.02 * 1.5 * 20, 1e-9);  // path_factor 1.5: drives are not straight
+  EXPECT_NEAR(u.yaw_deg, 0.3 * 1.5 * 2, 1e-9);
+  const MoveUncertainty still = drifting.odometry_uncertainty({0.1, 0, 0, 0});
+  EXPECT_GE(still.xy_m, 0.05) << "a robot that hardly moved still slips";
+
+  const ScanGraph fixes({}, PoseNoise{});  // absolute: two independent fixes
+  EXPECT_NEAR(fixes.odometry_uncertainty({20, 0, 0, 0}).xy_m, std::sqrt(2.0), 1e-9);
+}
+
+TEST(ScanGraph, APriorIsAsUnsureAsTheMovesSinceTheLastAnchoredScan) {
+  ScanGraph graph({}, drift());
+  graph.add(few_points(), placement(at(0, 0, 0), at(0, 0, 0), false));
+  EXPECT_FALSE(graph.prior_uncertainty("robot2", at(30, 0, 0))) << "another robot's first scan";
+  const MoveUncertainty one = *graph.prior_uncertainty("robot1", at(30, 0, 0));
+  graph.add(few_points(), placement(at(30, 0, 0), at(30, 0, 0), false));
+  EXPECT_FALSE(graph.anchored(1));
+  EXPECT_EQ(graph.last_anchored_of("robot1"), 0u);
+  const MoveUncertainty two = *graph.prior_uncertainty("robot1", at(60, 0, 0));
+  EXPECT_GT(two.xy_m, one.xy_m * 1.4) << "two moves since the last anchored scan";
+  EXPECT_GT(two.yaw_deg, one.yaw_deg * 1.4);
+  EXPECT_NEAR(graph.uncertainty(1).xy_m, one.xy_m, 1e-9);
+}
+
+// A match beyond the sensors' usual reach ties a scan in only when the robot's next scan,
+// placed by the map too, lies where the odometry between the two says.
+TEST(ScanGraph, AFarCorrectionIsBelievedWhenTheNextScanAgrees) {
+  for (const bool agree : {true, false}) {
+    ScanGraph graph({}, drift());
+    graph.add(few_points(), placement(at(0, 0, 0), at(0, 0, 0), false));
+    // The robot drove 150 m on drifting odometry: both reports are 8 m off the same way.
+    graph.add(few_points(), placement(at(150, 0, 0), at(150, 8, 0), true), /*tentative=*/true);
+    EXPECT_FALSE(graph.anchored(1)) << "one far correction alone is not believed";
+    const Pose next_placed = agree ? at(160, 8, 0) : at(160, -8, 0);  // a look-alike 16 m away
+    graph.add(few_points(), placement(at(160, 0, 0), next_placed, true), /*tentative=*/true);
+    EXPECT_EQ(graph.anchored(1), agree);
+    EXPECT_EQ(graph.anchored(2), agree);
+    if (agree) {
+      EXPECT_NEAR(graph.poses()[1].y, 8, 0.01);
+      EXPECT_EQ(graph.edge_origin(graph.graph().edges().size() - 1), "map-confirmed");
+    }
+  }
+}
+
+}  // namespace
+}  // namespace scanplan
