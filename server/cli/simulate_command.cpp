@@ -115,6 +115,7 @@ nlohmann::json scan_json(const LoopStep& s, const LoopStep& first, const LoopSte
           {"matched", pose_json(s.matched_pose)},
           {"joined", pose_json(s.placed_pose)},
           {"placed", pose_json(s.final_pose)},
+          {"in_map", s.final_in_map},
           {"true", pose_json(true_in_map(first.placed_pose, first.true_pose, s.true_pose))},
           {"placed_error_m", s.final_error_m},
           {"placed_error_deg", s.final_error_deg},
@@ -139,7 +140,7 @@ nlohmann::json scan_json(const LoopStep& s, const LoopStep& first, const LoopSte
 // truth relative to the first scan (median and worst over the scans after it), at the end and
 // from matching alone.
 nlohmann::json accuracy_of(const LoopResult& r) {
-  std::vector<double> metres, degrees, matched_m, matched_deg, solve_ms;
+  std::vector<double> metres, degrees, matched_m, matched_deg, solve_ms, in_map_m;
   int tried = 0, applied = 0;
   for (std::size_t k = 1; k < r.steps.size(); ++k) {
     const LoopStep& s = r.steps[k];
@@ -148,6 +149,7 @@ nlohmann::json accuracy_of(const LoopResult& r) {
     matched_m.push_back(s.matched_error_m);
     matched_deg.push_back(s.matched_error_deg);
     solve_ms.push_back(s.solve_ms);
+    if (s.final_in_map) in_map_m.push_back(s.final_error_m);
     tried += s.match.has_value();
     applied += s.match_applied;
   }
@@ -171,6 +173,9 @@ nlohmann::json accuracy_of(const LoopResult& r) {
           {"matched_error_median_deg", median(matched_deg)},
           {"matched_error_max_m", worst(matched_m)},
           {"matched_error_max_deg", worst(matched_deg)},
+          {"scans_in_map", in_map_m.size() + 1},
+          {"in_map_error_median_m", median(in_map_m)},
+          {"in_map_error_max_m", worst(in_map_m)},
           {"solve_ms_median", median(solve_ms)},
           {"solve_ms_max", worst(solve_ms)}};
 }

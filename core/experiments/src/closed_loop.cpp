@@ -100,6 +100,7 @@ void final_errors(const MissionPipeline& mission, LoopResult& result) {
   for (std::size_t k = 0; k < result.steps.size(); ++k) {
     LoopStep& s = result.steps[k];
     s.final_pose = mission.poses().at(k);
+    s.final_in_map = mission.in_map(k);
     if (k == 0) continue;
     const PoseError e = placed_error(first.placed_pose, first.true_pose, s.final_pose, s.true_pose);
     s.final_error_m = e.metres;
@@ -207,9 +208,8 @@ LoopResult run_closed_loop(
       const auto t0 = std::chrono::steady_clock::now();
       // Where the map knows the robot to be: its latest scan, or, when that one could not be
       // placed (it waits outside the map, perhaps metres off), the latest the map holds.
-      const Pose& at = mission.in_map(mission.poses().size() - 1)
-                           ? step.placed_pose
-                           : pipeline.scan_poses().back();
+      const Pose& at = mission.in_map(mission.poses().size() - 1) ? step.placed_pose
+                                                                  : pipeline.scan_poses().back();
       const Plan plan = mission.plan_from(
           {at.x, at.y, at.z}, config.planner.seed * 1000003u + static_cast<std::uint64_t>(scan));
       step.plan_ms =

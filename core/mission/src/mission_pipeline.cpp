@@ -126,7 +126,7 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
     return;
   }
   const std::vector<Pose> before = poses_;
-  GraphUpdate update = graph_->add(scan, where, where.matched && beyond_reach(where));
+  GraphUpdate update = graph_->add(scan, where, where.matched && unsure(where));
   follow_graph();
   if (rematch_refused(update)) follow_graph();
   last_correction_ = correction(update, before);
@@ -155,15 +155,25 @@ PointCloud MissionPipeline::own_frame(std::size_t i) const {
   return own;
 }
 
-// Whether a match moved the scan from where matching started farther than the pose sensors
-// usually err (MapMatchConfig::max_correction_m / _deg): the search reached that far only
-// because the robot drove far since its last anchored scan (match_input).
-bool MissionPipeline::beyond_reach(const Placement& where) const {
+// Whether a match is to wait for confirmation (ScanGraph::offer_match_to_map): it moved the scan
+// from where matching started farther than the pose sensors usually err
+// (MapMatchConfig::max_correction_m / _deg), which the search reached only because the robot
+// drove far since its last anchored scan (match_input), or it started from a pose that may be
+// off by more than that.
+bool MissionPipeline::unsure(const Placement& where) const {
   const PoseChange d = change(prior(where.reported, where.track), where.placed);
+  const std::optional<MoveUncertainty> u = graph_->prior_uncertainty(where.track, where.reported);
   return d.metres > config_.matching->max_correction_m ||
-         d.degrees > config_.matching->max_correction_deg;
+         d.degrees > config_.matching->max_correction_deg || (u && beyond_reach(*u));
 }
 
+// Whether a pose so uncertain may be off by more than the sensors usually err: a match found
+// within that reach of it may still be a look-alike of the true place (on the campus, 24 m off
+// with a correction of under 6 m, after a robot had lost its anchoring for a dozen scans).
+bool MissionPipeline::beyond_reach(const MoveUncertainty& u) const {
+  return 3 * std::sqrt(2.0) * u.xy_m > config_.matching->max_correction_m ||
+         3 * u.yaw_deg > config_.matching->max_correction_deg;
+}
 // A scan the map matcher refused when it came may match once more of the map is anchored
 // around it: the scans after it fill in what it overlaps with (issue 15's refusals were mostly
 // scans with too little anchored in view).
@@ -184,7 +194,12 @@ bool MissionPipeline::rematch_refused(GraphUpdate& update) {
         match_to_map(points_near(at.x, at.y, radius, /*anchored_only=*/true), graph_->thinned(u),
                      level(at), widened(*config_.matching, graph_->uncertainty(u)));
     if (!m.applied) continue;
-    graph_->add_match_to_map(u, m.placed, m.information);
+    if (beyond_reach(graph_->uncertainty(u)) ||
+        change(at, m.placed).metres > config_.matching->max_correction_m) {
+      graph_->offer_match_to_map(u, m.placed, m.information);
+    } else {
+      graph_->add_match_to_map(u, m.placed, m.information);
+    }
     ++update.rematched;
     any = true;
   }

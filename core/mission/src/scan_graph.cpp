@@ -127,8 +127,7 @@ GraphUpdate ScanGraph::add(const PointCloud& scan, const Placement& where, bool 
   GraphUpdate update;
   match_pairs(k, matched, update);
   if (matched) add_match_to_map(k, where.placed, where.information, "map");
-  if (where.matched && tentative) pending_map_[k] = MapCandidate{where.placed, where.information};
-  confirm_by_odometry(k);
+  if (where.matched && tentative) offer_match_to_map(k, where.placed, where.information);
   update.solve = solve();
   return update;
 }
@@ -142,26 +141,42 @@ bool ScanGraph::odometry_agrees(std::size_t a, const Pose& a_placed, std::size_t
   const MoveUncertainty u = odometry_uncertainty(move);
   const double off_m = std::hypot(predicted.x - b_placed.x, predicted.y - b_placed.y);
   const double off_deg = std::abs(rad2deg(std::remainder(predicted.yaw - b_placed.yaw, 2 * M_PI)));
-  return off_m <= std::max(0.5, 3 * std::sqrt(2.0) * u.xy_m) &&
-         off_deg <= std::max(1.0, 3 * u.yaw_deg);
+  // Never looser than a few metres: a look-alike lies a building's depth off, and a long drive's
+  // own error must not hide that.
+  return off_m <= std::clamp(3 * std::sqrt(2.0) * u.xy_m, 0.5, 3.0) &&
+         off_deg <= std::clamp(3 * u.yaw_deg, 1.0, 3.0);
 }
 
 // A map match that corrected the pose further than the sensors usually err (the search reached
 // farther because the robot drove far since its last anchored scan) is believed only when the
 // robot's previous scan, also corrected that far by its own map match, lies where the odometry
-// between the two says: both then carry the same drift, which a look-alike found in a repeated structure would
-// not (it lies one building's depth off for one scan, elsewhere for the other).
+// between the two says: both then carry the same drift, which a look-alike found in a repeated
+// structure would not (it lies one building's depth off for one scan, elsewhere for the other).
 void ScanGraph::confirm_by_odometry(std::size_t k) {
   // Both far corrections, each its own map match: the robot's anchored scans say nothing here,
-  // since matching started from them and the odometry.
-  const std::size_t p = previous_[k];
-  if (p == kNoNode || !pending_map_[p] || !pending_map_[k]) return;
-  if (!odometry_agrees(p, pending_map_[p]->placed, k, pending_map_[k]->placed)) return;
-  for (const std::size_t i : {p, k}) {
-    const MapCandidate c = *pending_map_[i];
-    pending_map_[i].reset();
-    add_match_to_map(i, c.placed, c.information, "map-confirmed");
+  // since matching started from them and the odometry. The robot's scan before and after.
+  std::vector<std::size_t> neighbours;
+  if (previous_[k] != kNoNode) neighbours.push_back(previous_[k]);
+  for (std::size_t n = k + 1; n < previous_.size(); ++n) {
+    if (previous_[n] == k) neighbours.push_back(n);
   }
+  for (const std::size_t n : neighbours) {
+    if (!pending_map_[k] || !pending_map_[n]) continue;
+    const std::size_t a = std::min(k, n), b = std::max(k, n);
+    if (!odometry_agrees(a, pending_map_[a]->placed, b, pending_map_[b]->placed)) continue;
+    for (const std::size_t i : {a, b}) {
+      const MapCandidate c = *pending_map_[i];
+      pending_map_[i].reset();
+      add_match_to_map(i, c.placed, c.information, "map-confirmed");
+    }
+    return;
+  }
+}
+
+void ScanGraph::offer_match_to_map(std::size_t scan, const Pose& placed,
+                                   const Eigen::Matrix4d& information) {
+  pending_map_[scan] = MapCandidate{placed, information};
+  confirm_by_odometry(scan);
 }
 
 GraphSolveReport ScanGraph::solve() {

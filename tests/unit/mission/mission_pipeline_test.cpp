@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "ground_pose.hpp"
 #include "scanplan/mission/mission_pipeline.hpp"
 #include "scanplan/sim/simulated_scanner.hpp"
 
@@ -36,13 +37,7 @@ class MissionPipelineTest : public ::testing::Test {
 World* MissionPipelineTest::world_ = nullptr;
 RayCaster* MissionPipelineTest::caster_ = nullptr;
 
-Pose at(double x, double y, double yaw_deg) {
-  Pose p;
-  p.x = x;
-  p.y = y;
-  p.yaw = deg2rad(yaw_deg);
-  return p;
-}
+constexpr auto* at = &testing_support::ground_pose;
 
 TEST_F(MissionPipelineTest, TheFirstScanDefinesTheMapFrameAndIsNotMatched) {
   MissionPipeline mission(config());

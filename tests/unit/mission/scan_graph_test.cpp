@@ -1,6 +1,7 @@
 // The scan graph's bookkeeping, without point clouds worth matching: how far the search reaches,
 // how sure odometry is, and when a match beyond the sensors' usual reach is believed.
 #include "scanplan/mission/scan_graph.hpp"
+#include "ground_pose.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,13 +10,7 @@
 namespace scanplan {
 namespace {
 
-Pose at(double x, double y, double yaw_deg) {
-  Pose p;
-  p.x = x;
-  p.y = y;
-  p.yaw = deg2rad(yaw_deg);
-  return p;
-}
+constexpr auto* at = &testing_support::ground_pose;
 
 PoseNoise drift() {
   PoseNoise n;

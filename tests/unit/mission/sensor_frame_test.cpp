@@ -6,18 +6,13 @@
 #include <cmath>
 #include <random>
 
+#include "ground_pose.hpp"
 #include "scanplan/mission/sensor_frame.hpp"
 
 namespace scanplan {
 namespace {
 
-Pose at(double x, double y, double yaw_deg) {
-  Pose p;
-  p.x = x;
-  p.y = y;
-  p.yaw = deg2rad(yaw_deg);
-  return p;
-}
+constexpr auto* at = &testing_support::ground_pose;
 
 // The map frame is the sensor frame turned by 5° and shifted by (3, −2, 0.4): what a first scan
 // reported 5° and a few metres off makes of it.

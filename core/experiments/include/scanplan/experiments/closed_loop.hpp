@@ -49,6 +49,9 @@ struct LoopStep {
   // The same for matched_pose (before the graph) and final_pose.
   double matched_error_m = 0, matched_error_deg = 0;
   double final_error_m = 0, final_error_deg = 0;
+  // Whether the map held the scan when the mission ended (with the graph, only scans tied in by
+  // a believed match are in it; the others wait, at the graph's estimate).
+  bool final_in_map = true;
   // The graph's work after this scan: pairs matched of those tried, the solve, and how far it
   // moved the scans already in the map.
   std::size_t pairs_tried = 0, pairs_matched = 0;

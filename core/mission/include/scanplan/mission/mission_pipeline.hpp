@@ -152,7 +152,8 @@ class MissionPipeline {
   std::vector<std::size_t> anchored_near_;
 
   bool rematch_refused(GraphUpdate& update);
-  bool beyond_reach(const Placement& where) const;
+  bool unsure(const Placement& where) const;
+  bool beyond_reach(const MoveUncertainty& u) const;
   std::vector<Eigen::Vector3d> unplaced_scan_points() const;
   void follow_graph();
   void join_map(const PointCloud& own, std::size_t i);

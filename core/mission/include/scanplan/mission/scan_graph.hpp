@@ -68,7 +68,7 @@ struct MoveUncertainty {
 // the search, the likelier it spans a repeated structure, and a match that another pose farther
 // out fits as well is not believed. It never reaches beyond kWidestSearchM / _Deg. The
 // correction applied stays within the sensors' usual reach (the callers' limits).
-inline constexpr double kWidestSearchM = 10.0;
+inline constexpr double kWidestSearchM = 20.0;
 inline constexpr double kWidestSearchDeg = 45.0;
 RegistrationConfig widened(RegistrationConfig config, const MoveUncertainty& prior);
 
@@ -100,6 +100,11 @@ class ScanGraph {
   // solve() after.
   void add_match_to_map(std::size_t scan, const Pose& placed, const Eigen::Matrix4d& information,
                         const char* origin = "rematch");
+  // A map match of a scan whose estimate may be off by more than the sensors' usual reach (a
+  // far correction, or a prior after long drives with nothing anchored): it waits until the
+  // robot's scan before or after, matched the same way, lies where the odometry between the two
+  // says (confirm_by_odometry), then ties both in. Call solve() after.
+  void offer_match_to_map(std::size_t scan, const Pose& placed, const Eigen::Matrix4d& information);
   GraphSolveReport solve();
 
   std::size_t size() const { return graph_.size(); }
