@@ -93,6 +93,33 @@ void place(MissionPipeline& mission, const PointCloud& cloud, LoopStep& step) {
   }
 }
 
+// The world's target region in the map frame.
+TargetRegion target_in_map(const World& world, const Eigen::Isometry3d& map_from_world) {
+  std::vector<Eigen::Vector2d> corners;
+  const TargetRegion region = world.target_region();
+  for (const Eigen::Vector2d& c : region.corners()) {
+    corners.push_back((map_from_world * Eigen::Vector3d(c.x(), c.y(), 0)).head<2>());
+  }
+  return TargetRegion::polygon(std::move(corners));
+}
+
+// How far the step's poses are from the truth, relative to the first scan.
+void step_errors(const LoopStep& first, LoopStep& step) {
+  const auto error = [&](const Pose& p, double& metres, double& degrees) {
+    const PoseError e = placed_error(first.placed_pose, first.true_pose, p, step.true_pose);
+    metres = e.metres;
+    degrees = e.degrees;
+  };
+  error(step.placed_pose, step.placed_error_m, step.placed_error_deg);
+  error(step.matched_pose, step.matched_error_m, step.matched_error_deg);
+  if (step.match_proposed) {
+    double m = 0, d = 0;
+    error(*step.match_proposed, m, d);
+    step.match_error_m = m;
+    step.match_error_deg = d;
+  }
+}
+
 // Where the graph had each scan when the mission ended, against the truth.
 void final_errors(const MissionPipeline& mission, LoopResult& result) {
   if (result.steps.empty()) return;
@@ -166,33 +193,12 @@ LoopResult run_closed_loop(
     if (scan == 1) {
       world_from_map = truth.isometry() * step.reported_pose.isometry().inverse();
       const Eigen::Isometry3d map_from_world = world_from_map.inverse();
-      std::vector<Eigen::Vector2d> corners;
-      const TargetRegion target = world.target_region();
-      for (const Eigen::Vector2d& c : target.corners()) {
-        corners.push_back((map_from_world * Eigen::Vector3d(c.x(), c.y(), 0)).head<2>());
-      }
-      mission.set_target(TargetRegion::polygon(std::move(corners)));
+      mission.set_target(target_in_map(world, map_from_world));
       ground = reachable_ground_cells(world, trav, start_reach, pipeline.map(), map_from_world);
       result.reachable_cells = ground.size();
     }
     place(mission, cloud, step);
-    if (!result.steps.empty()) {
-      const LoopStep& first = result.steps.front();
-      const auto error = [&](const Pose& p, double& metres, double& degrees) {
-        const PoseError e = placed_error(first.placed_pose, first.true_pose, p, step.true_pose);
-        metres = e.metres;
-        degrees = e.degrees;
-      };
-      error(step.placed_pose, step.placed_error_m, step.placed_error_deg);
-      error(step.matched_pose, step.matched_error_m, step.matched_error_deg);
-      if (step.match_proposed) {
-        double m = 0, d = 0;
-        error(*step.match_proposed, m, d);
-        step.match_error_m = m;
-        step.match_error_deg = d;
-      }
-    }
-
+    if (!result.steps.empty()) step_errors(result.steps.front(), step);
     const RegionMap& regions = *pipeline.regions();
     step.detected_m2 = regions.detected_m2();
     step.completed_m2 = regions.completed_m2();
