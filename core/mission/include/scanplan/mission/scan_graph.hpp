@@ -17,9 +17,10 @@ namespace scanplan {
 
 struct ScanGraphConfig {
   PoseGraphConfig solver;
-  // A new scan is matched with each earlier one whose position lies within this (x-y), the
-  // nearest first, at most max_pairs of them: pairs farther apart than the scanner's useful
-  // range share too little to be worth the time (the planner spaces scans 30–40 m).
+  // Pairwise matches (only where one scan of the pair is not in the map: match_pairs) with the
+  // earlier scans whose positions lie within this (x-y), the nearest first, at most max_pairs of
+  // them: pairs farther apart than the scanner's useful range share too little to be worth the
+  // time (the planner spaces scans 30–40 m).
   double pair_radius_m = 45.0;
   std::size_t max_pairs = 6;
   // The pairwise match: the search over how far off the scan not anchored may be, then GICP
@@ -66,8 +67,9 @@ struct MoveUncertainty {
 // odometry may be 9 m off. Widened, the search looks at more peaks and refuses a fit that
 // another distinct pose matches almost as well (PoseSearchConfig::ambiguity_ratio): the wider
 // the search, the likelier it spans a repeated structure, and a match that another pose farther
-// out fits as well is not believed. It never reaches beyond kWidestSearchM / _Deg. The
-// correction applied stays within the sensors' usual reach (the callers' limits).
+// out fits as well is not believed. It never reaches beyond kWidestSearchM / _Deg. A map match
+// that corrects beyond the sensors' usual reach waits for confirmation
+// (ScanGraph::offer_match_to_map); a pairwise one is refused (max_search_shift_m).
 inline constexpr double kWidestSearchM = 20.0;
 inline constexpr double kWidestSearchDeg = 45.0;
 RegistrationConfig widened(RegistrationConfig config, const MoveUncertainty& prior);
@@ -76,7 +78,8 @@ RegistrationConfig widened(RegistrationConfig config, const MoveUncertainty& pri
 struct GraphUpdate {
   std::size_t pairs_tried = 0, pairs_matched = 0;
   double match_ms = 0;  // the pairwise matches together
-  // Scans refused when they came and matched to the map again as it grew: tried, placed.
+  // Scans refused when they came and matched to the map again as it grew: tried, and matched
+  // (tied in, or waiting for the robot's neighbouring scan to agree).
   std::size_t rematches_tried = 0, rematched = 0;
   GraphSolveReport solve;
 };
