@@ -126,7 +126,10 @@ GraphUpdate ScanGraph::add(const PointCloud& scan, const Placement& where, bool 
 
   GraphUpdate update;
   match_pairs(k, matched, update);
-  if (matched) add_match_to_map(k, where.placed, where.information, "map");
+  if (matched) {
+    add_match_to_map(k, where.placed, where.information, "map");
+    confirm_by_odometry(k);  // the robot's scan before may be waiting for this one
+  }
   if (where.matched && tentative) offer_match_to_map(k, where.placed, where.information);
   update.solve = solve();
   return update;
@@ -153,30 +156,36 @@ bool ScanGraph::odometry_agrees(std::size_t a, const Pose& a_placed, std::size_t
 // between the two says: both then carry the same drift, which a look-alike found in a repeated
 // structure would not (it lies one building's depth off for one scan, elsewhere for the other).
 void ScanGraph::confirm_by_odometry(std::size_t k) {
-  // Both far corrections, each its own map match: the robot's anchored scans say nothing here,
-  // since matching started from them and the odometry. The robot's scan before and after.
-  std::vector<std::size_t> neighbours;
-  if (previous_[k] != kNoNode) neighbours.push_back(previous_[k]);
-  for (std::size_t n = k + 1; n < previous_.size(); ++n) {
-    if (previous_[n] == k) neighbours.push_back(n);
-  }
-  for (const std::size_t n : neighbours) {
-    if (!pending_map_[k] || !pending_map_[n]) continue;
-    const std::size_t a = std::min(k, n), b = std::max(k, n);
-    if (!odometry_agrees(a, pending_map_[a]->placed, b, pending_map_[b]->placed)) continue;
-    for (const std::size_t i : {a, b}) {
-      const MapCandidate c = *pending_map_[i];
-      pending_map_[i].reset();
-      add_match_to_map(i, c.placed, c.information, "map-confirmed");
-    }
+  // Two far corrections, each its own map match, agreeing: both are believed. The robot's
+  // anchored scan before a waiting one says nothing (matching started from it and the
+  // odometry); the one after it, placed by its own match, does (its match started elsewhere).
+  const std::size_t p = previous_[k];
+  if (p != kNoNode && pending_map_[p] && pending_map_[k] &&
+      odometry_agrees(p, pending_map_[p]->placed, k, pending_map_[k]->placed)) {
+    believe_waiting(p);
+    believe_waiting(k);
     return;
   }
+  if (p != kNoNode && pending_map_[p] && anchored_[k] && !pending_map_[k] &&
+      odometry_agrees(p, pending_map_[p]->placed, k, graph_.pose(k))) {
+    believe_waiting(p);
+  }
+}
+
+void ScanGraph::believe_waiting(std::size_t scan) {
+  const MapCandidate c = *pending_map_[scan];
+  pending_map_[scan].reset();
+  add_match_to_map(scan, c.placed, c.information, "map-confirmed");
 }
 
 void ScanGraph::offer_match_to_map(std::size_t scan, const Pose& placed,
                                    const Eigen::Matrix4d& information) {
   pending_map_[scan] = MapCandidate{placed, information};
   confirm_by_odometry(scan);
+  // A re-match of an older scan: the robot's scan after it may already be in the map.
+  for (std::size_t n = scan + 1; n < previous_.size() && pending_map_[scan]; ++n) {
+    if (previous_[n] == scan) confirm_by_odometry(n);
+  }
 }
 
 GraphSolveReport ScanGraph::solve() {

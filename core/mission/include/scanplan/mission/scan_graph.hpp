@@ -105,8 +105,9 @@ class ScanGraph {
                         const char* origin = "rematch");
   // A map match of a scan whose estimate may be off by more than the sensors' usual reach (a
   // far correction, or a prior after long drives with nothing anchored): it waits until the
-  // robot's scan before or after, matched the same way, lies where the odometry between the two
-  // says (confirm_by_odometry), then ties both in. Call solve() after.
+  // robot's scan before or after, matched the same way, or the one after placed by its own
+  // match, lies where the odometry between the two says (confirm_by_odometry). Call solve()
+  // after.
   void offer_match_to_map(std::size_t scan, const Pose& placed, const Eigen::Matrix4d& information);
   GraphSolveReport solve();
 
@@ -153,6 +154,7 @@ class ScanGraph {
   bool odometry_agrees(std::size_t a, const Pose& a_placed, std::size_t b,
                        const Pose& b_placed) const;
   void confirm_by_odometry(std::size_t scan);
+  void believe_waiting(std::size_t scan);
   Pose implied(const GraphEdge& edge, std::size_t scan) const;
 
   ScanGraphConfig config_;
