@@ -95,5 +95,17 @@ TEST(ScanGraph, AFarCorrectionIsBelievedWhenTheNextScanAgrees) {
   }
 }
 
+// The robot's next scan, placed by its own (ordinary) map match, confirms a waiting one too: its
+// match started from the last anchored scan, not from the waiting scan's correction.
+TEST(ScanGraph, AWaitingScanIsBelievedWhenTheNextScanIsPlacedWhereTheOdometrySays) {
+  ScanGraph graph({}, drift());
+  graph.add(few_points(), placement(at(0, 0, 0), at(0, 0, 0), false));
+  graph.add(few_points(), placement(at(150, 0, 0), at(150, 8, 0), true), /*tentative=*/true);
+  ASSERT_FALSE(graph.anchored(1));
+  graph.add(few_points(), placement(at(160, 0, 0), at(160, 8.3, 0), true));
+  EXPECT_TRUE(graph.anchored(2));
+  EXPECT_TRUE(graph.anchored(1));
+}
+
 }  // namespace
 }  // namespace scanplan
