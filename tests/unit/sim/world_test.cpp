@@ -36,6 +36,21 @@ TEST(World, ParsesBoxesStartAndOverrides) {
   EXPECT_DOUBLE_EQ(w.scanner.vertical_step_deg, 0.5);
   EXPECT_DOUBLE_EQ(w.pose_noise.xy_sigma_m, 0.0);
   EXPECT_DOUBLE_EQ(w.pose_noise.yaw_sigma_deg, 5.0);
+  EXPECT_EQ(w.pose_noise.model, OdometryModel::kDrift) << "drifting odometry unless told";
+}
+
+TEST(World, PoseNoiseChoosesItsModelAndFigures) {
+  const World w =
+      parse_world(world_with("", R"(, "pose_noise": {"model": "absolute", "xy_drift_fraction": 0.05,
+                                          "yaw_drift_deg_per_10m": 1, "z_drift_fraction": 0})"),
+                  "t.json");
+  EXPECT_EQ(w.pose_noise.model, OdometryModel::kAbsolute);
+  EXPECT_DOUBLE_EQ(w.pose_noise.xy_drift_fraction, 0.05);
+  EXPECT_DOUBLE_EQ(w.pose_noise.yaw_drift_deg_per_10m, 1.0);
+  expect_error(world_with("", R"(, "pose_noise": {"model": "gps"})"),
+               "pose_noise: field 'model' must be \"drift\" or \"absolute\"");
+  expect_error(world_with("", R"(, "pose_noise": {"xy_drift_fraction": -0.1})"),
+               "must not be negative");
 }
 
 TEST(World, ErrorsNameTheObjectAndField) {
