@@ -20,10 +20,11 @@ PoseChange change(const Pose& a, const Pose& b) {
 }
 
 // `config` searching, and correcting, as far as the pose it starts from may be off
-// (ScanGraph's uncertainty). A correction beyond the pose sensors' usual reach is not applied
-// as it stands (beyond_reach; ScanGraph::add's `tentative`): on the campus such corrections were
-// right 11 times and wrong twice, each time by one building's depth (16 m), and a scan placed
-// inside a building ends the mission.
+// (ScanGraph's uncertainty). A correction beyond the pose sensors' usual reach, or one from a
+// pose that may be off by more, is not applied as it stands (unsure(); ScanGraph::add's
+// `tentative`): on the campus, applied at once, such corrections were right 11 times and wrong
+// twice, each time by one building's depth (16 m), and a scan placed inside a building ends the
+// mission. `correct_as_far` false keeps the sensors' own limit.
 MapMatchConfig widened(MapMatchConfig config, const MoveUncertainty& prior,
                        bool correct_as_far = true) {
   config.registration = widened(config.registration, prior);
