@@ -39,8 +39,11 @@ constexpr int kReadsPerEvent = 4;
 constexpr std::size_t kRejectBacklog = 64;
 // After our final response we shut down writing and drain the client's leftovers for a while:
 // closing with unread input makes the kernel send RST, which can destroy the response in flight.
+// The bytes drained are capped at a large scan upload (a 350k-point PLY is 9 MB): a scan refused
+// at its headers (no operator token) is still on its way, and cutting it off at 1 MiB reset the
+// connection before the client had read its 403. The time bounds the work either way.
 constexpr std::chrono::milliseconds kLingerTime{2000};
-constexpr std::size_t kMaxLingerBytes = 1 << 20;
+constexpr std::size_t kMaxLingerBytes = 64u << 20;
 // Out of descriptors, the listener stays readable; pausing it avoids a busy loop.
 constexpr std::chrono::milliseconds kAcceptPause{100};
 // Upper bound on how long epoll_wait sleeps, so deadlines are checked regularly.
