@@ -236,13 +236,12 @@ void MissionPipeline::follow_graph() {
       rebuild = true;
     }
     if (!in_map_[i] && anchored_[i] && i != newest) rebuild = true;
-    if (!in_map_[i] || rebuild) poses_[i] = now;
+    if (!in_map_[i]) poses_[i] = now;
   }
   if (rebuild) {
     poses_ = graph_->poses();
     replace();
   } else if (anchored_[newest] && !in_map_[newest]) {
-    poses_[newest] = graph_->poses()[newest];
     join_map(own_frame(newest), newest);
   }
   // The points shown follow the graph wherever the scan is, in the map or not.
@@ -256,17 +255,20 @@ void MissionPipeline::follow_graph() {
 }
 
 // The anchored scans back in at their poses: the MLS map cannot take one scan out, and
-// rebuilding it costs a few milliseconds a scan (docs/benchmarks.md mls_campus).
+// rebuilding it costs a few milliseconds a scan (docs/benchmarks.md mls_campus). Only with the
+// graph, whose map is the anchored one (no anchored_map_ of its own).
 void MissionPipeline::replace() {
   const std::optional<TargetRegion> target = mapping_.target();
   mapping_ = MappingPipeline(with_planner_thresholds(config_.mapping, config_.planner));
   if (target) mapping_.set_target(*target);
-  if (anchored_map_) anchored_map_.emplace(config_.mapping.mls);
   sensor_frame_ = SensorFrame(config_.pose_noise);
   for (std::size_t i = 0; i < placed_.size(); ++i) {
     in_map_[i] = 0;
+    const bool moved =
+        change(cloud_poses_[i], poses_[i]).metres > 0 || cloud_poses_[i].yaw != poses_[i].yaw;
+    if (!moved && !anchored_[i]) continue;  // its points stay as they are, outside the map
     PointCloud own = own_frame(i);
-    if (change(cloud_poses_[i], poses_[i]).metres > 0 || cloud_poses_[i].yaw != poses_[i].yaw) {
+    if (moved) {
       placed_[i] = to_map_frame(own, poses_[i]);
       cloud_poses_[i] = poses_[i];
     }

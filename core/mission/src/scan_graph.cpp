@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "scanplan/geometry/pose_information.hpp"
 #include "scanplan/geometry/voxel_filter.hpp"
 
 namespace scanplan {
@@ -268,11 +269,8 @@ void ScanGraph::match_pairs(std::size_t k, bool matched_to_map, GraphUpdate& upd
 // by the move alone (odometry is good over one move, whatever came before), others by what
 // each end's own estimate may be off.
 MoveUncertainty ScanGraph::relative_uncertainty(std::size_t from, std::size_t to) const {
-  for (const GraphEdge& e : graph_.edges()) {
-    if (e.kind == EdgeKind::kOdometry && e.from == from && e.to == to) {
-      return odometry_uncertainty(e.measured);
-    }
-  }
+  if (previous_[to] == from)
+    return odometry_uncertainty(relative_pose(reported_[from], reported_[to]));
   const MoveUncertainty& f = uncertain_[from];
   const MoveUncertainty& t = uncertain_[to];
   return {std::hypot(f.xy_m, t.xy_m), std::hypot(f.z_m, t.z_m), std::hypot(f.yaw_deg, t.yaw_deg)};

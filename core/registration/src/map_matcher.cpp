@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "scanplan/geometry/pose_information.hpp"
+
 namespace scanplan {
 
 MapMatch match_to_map(const PointCloud& map_points, const PointCloud& scan, const Pose& reported,
@@ -30,12 +32,8 @@ MapMatch match_to_map(const PointCloud& map_points, const PointCloud& scan, cons
   out.result = register_scans(target, scan, initial, config.method, sized);
   const Pose corrected = Pose::from_isometry(map_from_level * out.result.transform);
   if (out.result.iterations > 0) out.proposed = corrected;
-  {
-    // The level frame is the map's turned by the reported yaw: v_map = Rz(yaw)·v_level.
-    Eigen::Matrix4d R = Eigen::Matrix4d::Identity();
-    R.topLeftCorner<2, 2>() = Eigen::Rotation2Dd(reported.yaw).toRotationMatrix();
-    out.information = R * out.result.information * R.transpose();
-  }
+  // The level frame is the map's turned by the reported yaw.
+  out.information = turned_information(out.result.information, -reported.yaw);
   const auto refuse = [&]() -> MapMatch {
     if (!config.level_refused) return out;
     // The level frame is vertical, so its z offset is the map's.

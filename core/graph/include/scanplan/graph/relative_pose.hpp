@@ -20,8 +20,4 @@ Pose compose(const Pose& from, const RelativePose& relative, double to_roll, dou
 // `from`'s measured tilt.
 RelativePose relative_pose(const Pose& from, const Eigen::Isometry3d& from_to);
 
-// An information matrix over (x, y, z, yaw) whose x-y is expressed in one frame, expressed in a
-// frame turned by `turn` radians about z from it (Ω' = R Ω Rᵀ, R turning x-y by −turn).
-Eigen::Matrix4d turned_information(const Eigen::Matrix4d& information, double turn);
-
 }  // namespace scanplan
