@@ -55,6 +55,9 @@ namespace srv = scanplan::server;
 struct Options {
   std::string session_dir, listen = "127.0.0.1:8080", web_dir = SCANPLAN_DEFAULT_WEB_DIR;
   std::uint32_t domain = 0;
+  // How the robots' reported poses go wrong: the pose graph weighs their odometry by it, and
+  // with drift a scan's match starts from the robot's last placed scan.
+  std::string odometry = "drift";
   // One event loop per core by default: the page, the terminal clients and the other robots'
   // tools poll the API while scans are processed on other threads.
   int http_threads = static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 4u));
@@ -66,6 +69,13 @@ void add_options(CLI::App& app, Options& o) {
       ->capture_default_str();
   app.add_option("--domain", o.domain, "DDS domain id")->capture_default_str();
   app.add_option("--web", o.web_dir, "directory of the built web page")->capture_default_str();
+  app.add_option("--odometry", o.odometry,
+                 "drift|absolute|exact: the robots' pose sensors: integrated odometry that "
+                 "drifts with the distance driven, an absolute fix with bounded noise, or exact "
+                 "poses (a total station, a simulation without noise: scans join the map where "
+                 "they are reported even when no match places them)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"drift", "absolute", "exact"}));
   app.add_option("--http-threads", o.http_threads, "HTTP event loops sharing the port")
       ->capture_default_str()
       ->check(CLI::Range(1, kMaxHttpThreads));
@@ -156,7 +166,13 @@ void run(const Options& o) {
   const srv::Events events(&hub);
   srv::PlanBook plans;
   srv::RobotBoard robots;
-  srv::LiveMap map(plans);
+  scanplan::MissionConfig mission_config;
+  if (o.odometry == "exact") {
+    mission_config.pose_noise = {0, 0, 0, scanplan::OdometryModel::kAbsolute};
+  } else {
+    mission_config.pose_noise.model = *scanplan::parse_odometry_model(o.odometry);
+  }
+  srv::LiveMap map(plans, mission_config);
   srv::ScanIntake intake(session, map, events);
   srv::DdsLink dds(o.domain, robots, intake, events);
   srv::Mission mission(map, plans, robots, dds, session, events);

@@ -49,8 +49,9 @@ json dropped_json(const DroppedReturns& d) {
           {"saturated", d.saturated}};
 }
 
-json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas) {
+json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas, bool in_map) {
   return {{"id", s.id},
+          {"in_map", in_map},
           {"robot", s.robot},
           {"points", s.points},
           {"estimated", pose_json(s.estimated)},
@@ -196,13 +197,23 @@ json match_done_json(std::int64_t scan, const Pose& e, const MapMatch& m) {
             {"yaw_deg", rad2deg(std::remainder(p.yaw - e.yaw, 2 * M_PI))}}}};
 }
 
-json map_updated_json(const StoredScan& scan, const MapAreas& a) {
+json map_updated_json(const StoredScan& scan, const MapAreas& a, bool in_map) {
   return {{"scan", scan.id},
           {"points", scan.points},
+          {"in_map", in_map},
           {"completed_m2", a.completed_m2},
           {"low_resolution_m2", a.low_resolution_m2},
           {"unscanned_m2", a.unscanned_m2},
           {"movable_m2", a.movable_m2}};
+}
+
+json map_corrected_json(const MapCorrected& c, std::int64_t revision) {
+  return {{"scans", c.moved},
+          {"joined", c.joined},
+          {"left", c.left},
+          {"max_moved_m", c.max_moved_m},
+          {"max_turned_deg", c.max_turned_deg},
+          {"revision", revision}};
 }
 
 json plan_done_json(const PlanRecord& plan) {

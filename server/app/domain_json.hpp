@@ -26,7 +26,9 @@ nlohmann::json layer_geometry_json(const LayerGeometry& g);
 nlohmann::json not_in_map_json(const std::vector<ScanIntake::NotInMap>& scans);
 // What drop_bad_returns left out of a scan, by kind.
 nlohmann::json dropped_json(const DroppedReturns& d);
-nlohmann::json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas);
+// `in_map`: false for a scan waiting outside the map for a match that ties it in (and for
+// one the operator took out).
+nlohmann::json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas, bool in_map);
 nlohmann::json candidate_json(const CandidateRecord& r, const std::string& robot,
                               std::uint64_t plan);
 // A plan without its candidates: {id, based_on_scan, robot, policy, alpha, plan_ms, candidates}.
@@ -45,7 +47,10 @@ nlohmann::json decision_json(const SessionEvent& e);
 
 // Event payloads (docs/api.md "Events").
 nlohmann::json match_done_json(std::int64_t scan, const Pose& estimated, const MapMatch& m);
-nlohmann::json map_updated_json(const StoredScan& scan, const MapAreas& a);
+nlohmann::json map_updated_json(const StoredScan& scan, const MapAreas& a, bool in_map);
+// The pose graph moved scans, or tied them into the map or set them outside it (revision: the
+// session's pose revision that records it; 0 when it could not be recorded).
+nlohmann::json map_corrected_json(const MapCorrected& c, std::int64_t revision);
 nlohmann::json plan_done_json(const PlanRecord& plan);
 nlohmann::json scan_progress_json(const std::string& robot, const RobotScanState& s);
 nlohmann::json robot_status_json(const std::string& robot, const RobotStatus& s);

@@ -15,18 +15,28 @@ namespace scanplan::server {
 
 namespace {
 
-// The server keeps its own copies of what the pipeline places (points per scan, Draco chunks,
-// the stored poses); until those follow the pose graph's corrections, its scans stay where the
-// map match put them, as before the graph.
-MissionConfig without_graph(MissionConfig config) {
-  config.graph.reset();
-  return config;
+struct PoseChange {
+  double metres = 0, degrees = 0;
+};
+
+PoseChange change(const Pose& a, const Pose& b) {
+  return {std::hypot(b.x - a.x, b.y - a.y, b.z - a.z),
+          std::abs(rad2deg(std::remainder(b.yaw - a.yaw, 2 * M_PI)))};
+}
+
+// Where a stored scan joins the mission: its match (if believed) with the match's information,
+// on its robot's track.
+Placement placement_of(const StoredScan& scan) {
+  Placement where(scan.estimated, scan.placed, scan.match && scan.match->applied);
+  if (scan.match) where.information = scan.match->information;
+  where.track = scan.robot;
+  return where;
 }
 
 }  // namespace
 
 LiveMap::LiveMap(PlanBook& plans, MissionConfig config)
-    : mission_(without_graph(std::move(config))),
+    : mission_(std::move(config)),
       sensor_height_m_(mission_.config().mapping.sensor_height_m),
       plans_(plans),
       claim_separation_m_(mission_.planner().claim_separation_m),
@@ -46,7 +56,10 @@ void LiveMap::encode_loop() {
   for (;;) {
     encode_wanted_.wait(lock, [&] { return stopping_ || encoded_generation_ != generation_; });
     if (stopping_) return;
-    const auto parts = placed_;
+    std::vector<std::shared_ptr<const PointCloud>> parts;
+    for (std::size_t i = 0; i < placed_.size(); ++i) {
+      if (in_map_[i]) parts.push_back(placed_[i]);
+    }
     const std::int64_t last = scans_.empty() ? 0 : scans_.back().id;
     const std::uint64_t generation = generation_;
     const std::size_t count = point_count_;
@@ -79,52 +92,133 @@ const std::vector<std::string>& LiveMap::layer_names() {
   return kNames;
 }
 
-std::optional<MapMatch> LiveMap::place(const PointCloud& scan, const Pose& reported) const {
+std::optional<MapMatch> LiveMap::place(const PointCloud& scan, const Pose& reported,
+                                       const std::string& robot) const {
   // Only the copy of the map's points near the scan under the lock: the match itself takes
   // hundreds of milliseconds, and parameter changes and goals must not wait for it.
   std::optional<MissionPipeline::MatchInput> in;
   {
     std::lock_guard encode_lock(encode_mutex_);
-    in = mission_.match_input(reported);
+    in = mission_.match_input(reported, robot);
   }
   if (!in) return std::nullopt;
   return match_to_map(in->map_points, scan, in->prior, in->config);
 }
 
-std::vector<PlanRecord> LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
-  const Pose& pose = scan.placed;
+LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
   // The scan in the map frame and its own Draco chunk first: should either fail (out of
   // memory, a Draco error), nothing of the scan has reached the map yet.
-  std::shared_ptr<const PointCloud> shared = MissionPipeline::to_map_frame(cloud, pose);
-  const Bounds3 added = bounds_of(*shared);
+  std::shared_ptr<const PointCloud> shared = MissionPipeline::to_map_frame(cloud, scan.placed);
   std::shared_ptr<const std::string> chunk;
   if (!shared->empty()) chunk = std::make_shared<const std::string>(encode_draco(*shared));
   // Writers take turns on encode_mutex_; readers only wait for the short commit below, and
   // they see the scan, its points, its chunk and the plan that includes it appear together.
   std::lock_guard encode_lock(encode_mutex_);
-  mission_.add(cloud, {scan.estimated, pose, scan.match && scan.match->applied}, shared);
-  thinned_.add(*shared);
+  mission_.add(cloud, placement_of(scan), shared);
+  // Only writers change the scans, under encode_mutex_ (held): read without mutex_.
+  std::vector<StoredScan> scans = scans_;
+  std::vector<std::shared_ptr<const PointCloud>> placed = placed_;
+  std::vector<std::uint8_t> in_map = in_map_;
+  scans.push_back(scan);
+  placed.push_back(shared);
+  in_map.push_back(0);
+  Followed f = follow_mission(std::move(scans), std::move(placed), std::move(in_map));
+  rethin(f, /*whole=*/!f.corrected.empty());
+  for (const StoredScan& s : f.scans) scan_pose_of_[s.robot] = s.placed;
   last_scan_ = {scan.id, scan.robot};
-  scan_pose_of_[scan.robot] = pose;
-  const auto plans = refresh_derived([&] {
-    scans_.push_back(scan);
-    ++generation_;
-    chunks_[scan.id] = chunk;
-    point_count_ += shared->size();
-    placed_.push_back(std::move(shared));
-    if (added.valid()) {
-      bounds_.extend(added.min);
-      bounds_.extend(added.max);
-    }
+  Added out;
+  out.corrected = f.corrected;
+  out.in_map = f.in_map.back() != 0;
+  const bool own_chunk = f.placed.back() == shared;
+  out.plans = refresh_derived([&] {
+    commit(std::move(f));
+    if (own_chunk) chunks_[scan.id] = chunk;
   });
   encode_wanted_.notify_one();
   // Outside mutex_ so readers are not held up, inside encode_mutex_ so maps and plans go out in
   // the order they were made; the map first, as the plan is made from it.
   if (on_map) on_map(thinned_.cloud());
   if (on_plan) {
-    for (const PlanRecord& plan : plans) on_plan(plan);
+    for (const PlanRecord& plan : out.plans) on_plan(plan);
   }
-  return plans;
+  return out;
+}
+
+LiveMap::Followed LiveMap::follow_mission(std::vector<StoredScan> scans,
+                                          std::vector<std::shared_ptr<const PointCloud>> placed,
+                                          std::vector<std::uint8_t> in_map) const {
+  Followed f;
+  const MissionConfig& config = mission_.config();
+  const std::size_t newest = scans.size() - 1;
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    const Pose& now = mission_.poses()[i];
+    const bool now_in = mission_.in_map(i);
+    const bool was_in = in_map[i] != 0;
+    const PoseChange d = change(scans[i].placed, now);
+    const bool moved = d.metres > config.replace_m || d.degrees > config.replace_deg;
+    if (moved) {
+      scans[i].placed = now;
+      placed[i] = mission_.placed_scans()[i];
+      f.unencoded.push_back(scans[i].id);
+    }
+    in_map[i] = now_in ? 1 : 0;
+    MapCorrected& c = f.corrected;
+    if (i == newest) {
+      if (moved || !now_in) c.poses.push_back({scans[i].id, now, now_in});
+      continue;
+    }
+    if (moved && was_in && now_in) {
+      c.moved.push_back(scans[i].id);
+      c.max_moved_m = std::max(c.max_moved_m, d.metres);
+      c.max_turned_deg = std::max(c.max_turned_deg, d.degrees);
+    }
+    if (now_in && !was_in) c.joined.push_back(scans[i].id);
+    if (was_in && !now_in) c.left.push_back(scans[i].id);
+    if (moved || now_in != was_in) c.poses.push_back({scans[i].id, scans[i].placed, now_in});
+  }
+  // Bounds of the points that changed; the others' stay (under encode_mutex_, held by the
+  // caller, placed_ changes in no other thread).
+  f.bounds = scan_bounds_;
+  f.bounds.resize(placed.size());
+  for (std::size_t i = 0; i < placed.size(); ++i) {
+    if (i >= placed_.size() || placed_[i] != placed[i]) f.bounds[i] = bounds_of(*placed[i]);
+  }
+  f.scans = std::move(scans);
+  f.placed = std::move(placed);
+  f.in_map = std::move(in_map);
+  return f;
+}
+
+void LiveMap::rethin(const Followed& f, bool whole) {
+  if (!whole) {
+    if (f.in_map.back()) thinned_.add(*f.placed.back());
+  } else {
+    // The thinned map cannot take a scan out: made anew from the scans in the map.
+    VoxelMap thinned{kThinnedMapVoxelM};
+    for (std::size_t i = 0; i < f.placed.size(); ++i) {
+      if (f.in_map[i]) thinned.add(*f.placed[i]);
+    }
+    thinned_ = std::move(thinned);
+  }
+}
+
+void LiveMap::commit(Followed f) {
+  for (const std::int64_t id : f.unencoded) chunks_[id] = nullptr;
+  scan_bounds_ = std::move(f.bounds);
+  scans_ = std::move(f.scans);
+  placed_ = std::move(f.placed);
+  in_map_ = std::move(f.in_map);
+  point_count_ = 0;
+  bounds_ = Bounds3{};
+  for (std::size_t i = 0; i < scans_.size(); ++i) {
+    if (!in_map_[i]) continue;
+    point_count_ += placed_[i]->size();
+    if (scan_bounds_[i].valid()) {
+      bounds_.extend(scan_bounds_[i].min);
+      bounds_.extend(scan_bounds_[i].max);
+    }
+  }
+  ++generation_;
 }
 
 namespace {
@@ -348,6 +442,15 @@ std::vector<StoredScan> LiveMap::scans() const {
   return scans_;
 }
 
+std::vector<std::int64_t> LiveMap::waiting() const {
+  std::lock_guard lock(mutex_);
+  std::vector<std::int64_t> out;
+  for (std::size_t i = 0; i < scans_.size(); ++i) {
+    if (!in_map_[i]) out.push_back(scans_[i].id);
+  }
+  return out;
+}
+
 std::optional<StoredScan> LiveMap::last_scan() const {
   std::lock_guard lock(mutex_);
   if (scans_.empty()) return std::nullopt;
@@ -388,69 +491,66 @@ LiveMap::Rebuilt LiveMap::rebuild(const std::vector<StoredScan>& keep, const Sca
                                   const std::function<void(std::size_t)>& progress) {
   Rebuilt out;
   std::lock_guard encode_lock(encode_mutex_);
-  std::map<std::int64_t,
-           std::pair<std::shared_ptr<const PointCloud>, std::shared_ptr<const std::string>>>
-      held;
-  {
-    std::lock_guard lock(mutex_);
-    for (std::size_t i = 0; i < scans_.size(); ++i) {
-      const auto chunk = chunks_.find(scans_[i].id);
-      held[scans_[i].id] = {placed_[i], chunk == chunks_.end() ? nullptr : chunk->second};
-    }
+  // The points the map holds, with the pose they are at (read without mutex_: only writers,
+  // holding encode_mutex_, change them).
+  std::map<std::int64_t, std::pair<std::shared_ptr<const PointCloud>, Pose>> held;
+  for (std::size_t i = 0; i < scans_.size(); ++i) {
+    held[scans_[i].id] = {placed_[i], scans_[i].placed};
   }
-  // A new pipeline fed the kept scans in their order, at their placed poses: the MLS map, the
-  // anchored map and the sensors' frame as if the others had never come. The map frame and the
-  // target region stay.
+  // A new pipeline fed the kept scans in their order, each where its match put it: the MLS
+  // map, the anchored map, the pose graph and the sensors' frame as if the others had never
+  // come. The map frame and the target region stay.
   MissionPipeline fresh(mission_.config());
   fresh.set_planner(mission_.planner());
   if (const auto& target = mission_.mapping().target()) fresh.set_target(*target);
-  VoxelMap thinned{kThinnedMapVoxelM};
   std::vector<StoredScan> scans;
-  std::vector<std::shared_ptr<const PointCloud>> placed;
-  std::map<std::int64_t, std::shared_ptr<const std::string>> chunks;
-  std::map<std::string, Pose> pose_of;
-  Bounds3 bounds;
-  std::size_t count = 0;
   for (const StoredScan& s : keep) {
-    auto [in_map, chunk] = held.count(s.id) ? held[s.id] : decltype(held)::mapped_type{};
-    if (!in_map) {
+    PointCloud own;
+    if (const auto it = held.find(s.id); it != held.end()) {
+      own = in_own_frame(*it->second.first, it->second.second);
+    } else {
       try {
-        in_map = MissionPipeline::to_map_frame(load(s), s.placed);
+        own = load(s);
       } catch (const std::exception& e) {
         out.skipped.push_back({s, e.what()});  // its file is gone or damaged: the rest go on
         continue;
       }
     }
-    if (!chunk && !in_map->empty()) {
-      chunk = std::make_shared<const std::string>(encode_draco(*in_map));
-    }
-    fresh.add(in_own_frame(*in_map, s.placed), {s.estimated, s.placed, s.match && s.match->applied},
-              in_map);
-    thinned.add(*in_map);
-    const Bounds3 b = bounds_of(*in_map);
-    if (b.valid()) {
-      bounds.extend(b.min);
-      bounds.extend(b.max);
-    }
-    count += in_map->size();
-    pose_of[s.robot] = s.placed;
+    fresh.add(own, placement_of(s));
     scans.push_back(s);
-    placed.push_back(std::move(in_map));
-    chunks[s.id] = std::move(chunk);
     if (progress) progress(scans.size());
   }
   mission_ = std::move(fresh);
-  thinned_ = std::move(thinned);
-  // Where each robot last scanned stays where it is: the robot has not moved.
-  for (const auto& [robot, pose] : pose_of) scan_pose_of_.try_emplace(robot, pose);
+  // Everything as the new pipeline has it; a scan whose points stay where they were keeps its
+  // chunk.
+  Followed f;
+  std::map<std::int64_t, std::shared_ptr<const std::string>> chunks;
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    StoredScan& s = scans[i];
+    s.placed = mission_.poses()[i];
+    f.placed.push_back(mission_.placed_scans()[i]);
+    f.in_map.push_back(mission_.in_map(i) ? 1 : 0);
+    f.bounds.push_back(bounds_of(*f.placed.back()));
+    const auto was = held.find(s.id);
+    const auto chunk = chunks_.find(s.id);
+    const bool same = was != held.end() && chunk != chunks_.end() &&
+                      change(was->second.second, s.placed).metres == 0 &&
+                      was->second.second.yaw == s.placed.yaw;
+    chunks[s.id] = same ? chunk->second : nullptr;
+  }
+  // A robot stands where it last scanned, as the graph now has that scan; where that scan was
+  // taken out, where it was (the robot has not moved).
+  std::map<std::string, std::int64_t> last_of;
+  for (const StoredScan& s : scans_) last_of[s.robot] = s.id;
+  for (const StoredScan& s : scans) {
+    if (last_of.count(s.robot) && last_of[s.robot] == s.id) scan_pose_of_[s.robot] = s.placed;
+  }
+  f.scans = std::move(scans);
+  rethin(f, /*whole=*/true);
   out.plans = refresh_derived(
       [&] {
-        scans_ = std::move(scans);
-        placed_ = std::move(placed);
+        commit(std::move(f));
         chunks_ = std::move(chunks);
-        point_count_ = count;
-        bounds_ = bounds;
-        ++generation_;
       },
       /*scan_joined=*/false);
   encode_wanted_.notify_one();
@@ -469,16 +569,35 @@ LiveMap::EncodedMap LiveMap::encoded_map(std::chrono::milliseconds wait) const {
   return {encoded_, encoded_last_scan_};
 }
 
+std::optional<std::size_t> LiveMap::index_of(std::int64_t id) const {
+  const auto it = std::lower_bound(scans_.begin(), scans_.end(), id,
+                                   [](const StoredScan& s, std::int64_t v) { return s.id < v; });
+  if (it == scans_.end() || it->id != id) return std::nullopt;
+  return static_cast<std::size_t>(it - scans_.begin());
+}
+
 std::shared_ptr<const std::string> LiveMap::encoded_chunk(std::int64_t id) const {
+  std::shared_ptr<const PointCloud> points;
+  {
+    std::lock_guard lock(mutex_);
+    const auto at = index_of(id);
+    if (!at) return nullptr;
+    if (const auto it = chunks_.find(id); it != chunks_.end() && it->second) return it->second;
+    points = placed_[*at];
+  }
+  // A scan the graph moved: its chunk is made when first asked for, outside the lock.
+  if (points->empty()) return nullptr;
+  auto chunk = std::make_shared<const std::string>(encode_draco(*points));
   std::lock_guard lock(mutex_);
-  const auto it = chunks_.find(id);
-  return it == chunks_.end() ? nullptr : it->second;
+  if (const auto at = index_of(id); at && placed_[*at] == points) chunks_[id] = chunk;
+  return chunk;
 }
 
 LiveMap::EncodedMap LiveMap::encoded_since(std::int64_t since_id) const {
   PointCloud tail;
   std::int64_t last = 0;
   bool whole = false;
+  std::optional<std::int64_t> one;
   {
     std::lock_guard lock(mutex_);
     if (scans_.empty()) return {};
@@ -492,12 +611,16 @@ LiveMap::EncodedMap LiveMap::encoded_since(std::int64_t since_id) const {
     }
     if (first == scans_.size()) return {nullptr, last};
     whole = first == 0;
-    // The common case, one scan behind, is already encoded.
-    if (first + 1 == scans_.size()) return {chunks_.at(scans_[first].id), last};
-    if (!whole) {
-      for (std::size_t i = first; i < placed_.size(); ++i) tail.append(*placed_[i]);
+    one = first + 1 == scans_.size() ? std::optional(scans_[first].id) : std::nullopt;
+    if (one && !in_map_[first]) return {nullptr, last};
+    if (!whole && !one) {
+      for (std::size_t i = first; i < placed_.size(); ++i) {
+        if (in_map_[i]) tail.append(*placed_[i]);
+      }
     }
   }
+  // The common case, one scan behind, is encoded already.
+  if (one) return {encoded_chunk(*one), last};
   if (whole) return encoded_map();
   if (tail.empty()) return {nullptr, last};
   return {std::make_shared<const std::string>(encode_draco(tail)), last};
@@ -506,6 +629,7 @@ LiveMap::EncodedMap LiveMap::encoded_since(std::int64_t since_id) const {
 LiveMap::EncodedMap LiveMap::encoded_range(std::int64_t since_id, std::int64_t until_id) const {
   PointCloud part;
   std::int64_t last = 0;
+  std::optional<std::int64_t> one;
   {
     std::lock_guard lock(mutex_);
     std::size_t first = scans_.size(), end = 0;
@@ -518,9 +642,16 @@ LiveMap::EncodedMap LiveMap::encoded_range(std::int64_t since_id, std::int64_t u
       }
     }
     if (first >= end) return {nullptr, last};
-    if (first + 1 == end) return {chunks_.at(scans_[first].id), last};
-    for (std::size_t i = first; i < end; ++i) part.append(*placed_[i]);
+    if (first + 1 == end) {
+      if (!in_map_[first]) return {nullptr, last};
+      one = scans_[first].id;
+    } else {
+      for (std::size_t i = first; i < end; ++i) {
+        if (in_map_[i]) part.append(*placed_[i]);
+      }
+    }
   }
+  if (one) return {encoded_chunk(*one), last};
   if (part.empty()) return {nullptr, last};
   return {std::make_shared<const std::string>(encode_draco(part)), last};
 }

@@ -57,6 +57,18 @@ struct MissionParams {
   std::optional<TargetRegion> target;  // nothing: the pipeline's default square
 };
 
+// What the pose graph did to the map when a scan joined (issue 17): scans it moved farther than
+// MissionConfig::replace_m / _deg (their points re-placed, their chunks made anew), scans a match
+// tied into the map at last, and scans that left it (the graph set their tie aside).
+struct MapCorrected {
+  std::vector<std::int64_t> moved, joined, left;  // scan ids, ascending
+  double max_moved_m = 0, max_turned_deg = 0;     // of the moved scans
+  // The poses to record as the session's next revision: every scan above, and the new scan
+  // when the graph did not leave it where its match put it or it waits outside the map.
+  std::vector<RevisedPose> poses;
+  bool empty() const { return moved.empty() && joined.empty() && left.empty(); }
+};
+
 // The scans of this session, in the map frame, with what is derived from them: each scan's
 // Draco chunk, the MLS map with its regions (the mission pipeline), the top-view layers as PNG
 // and each robot's plan (into the plan book), rebuilt off the network thread each time a scan
@@ -87,9 +99,17 @@ class LiveMap {
   std::function<void(const PlanRecord& plan)> on_plan;
 
   // A stored scan joins the map: `cloud` is in the scan's own frame, `scan.placed` puts it in
-  // the map frame. Scans must come in id order. Returns the plans made after it (one per robot
-  // not driving to a goal; the scanning robot's last).
-  std::vector<PlanRecord> add(const StoredScan& scan, const PointCloud& cloud);
+  // the map frame (where its match put it; scan.match's information weighs it in the pose
+  // graph). Scans must come in id order. Returns the plans made after it (one per robot not
+  // driving to a goal; the scanning robot's last) and what the pose graph changed.
+  // With the graph, a scan no believed match ties in waits outside the map (waiting()): its
+  // points are in no map encoding, thinned map or bounds until it joins.
+  struct Added {
+    std::vector<PlanRecord> plans;
+    MapCorrected corrected;
+    bool in_map = true;  // the new scan joined the map (with the graph, it may wait outside)
+  };
+  Added add(const StoredScan& scan, const PointCloud& cloud);
 
   // The map made anew from `keep` (stored scans, in id order, at their placed poses): after the
   // operator took a scan out or put one back. Points of scans the map holds are reused; the
@@ -103,10 +123,15 @@ class LiveMap {
   Rebuilt rebuild(const std::vector<StoredScan>& keep, const ScanLoader& load,
                   const std::function<void(std::size_t)>& progress = {});
 
+  // The scans, in id order, each `placed` where the map has it now (the pose graph's latest).
   std::vector<StoredScan> scans() const;
-  // Where a new scan goes: matched against the map so far (MissionPipeline::place). Nothing when
-  // matching is off or the map is empty. Call from the thread that calls add().
-  std::optional<MapMatch> place(const PointCloud& scan, const Pose& reported) const;
+  // The scans waiting outside the map for a match that ties them in, ascending.
+  std::vector<std::int64_t> waiting() const;
+  // Where a new scan of `robot` goes: matched against the map so far (MissionPipeline::place;
+  // with drifting odometry from the robot's latest placed scan). Nothing when matching is off
+  // or the map is empty. Call from the thread that calls add().
+  std::optional<MapMatch> place(const PointCloud& scan, const Pose& reported,
+                                const std::string& robot = {}) const;
   std::size_t scan_count() const;
   std::optional<StoredScan> last_scan() const;
   std::size_t point_count() const;
@@ -124,7 +149,8 @@ class LiveMap {
   // The points of the scans with since_id < id <= until_id; last_scan is the newest scan
   // included, or when there is none the newest scan up to until_id in the map.
   EncodedMap encoded_range(std::int64_t since_id, std::int64_t until_id) const;
-  // Scan `id`'s own points in the map frame, Draco-encoded; null for an unknown id.
+  // Scan `id`'s own points in the map frame, Draco-encoded (made when first asked for after the
+  // scan moved); null for an unknown id or a scan without points.
   std::shared_ptr<const std::string> encoded_chunk(std::int64_t id) const;
   // A top-view layer as PNG: "regions", "elevation" or "movable"; null before the first scan.
   std::shared_ptr<const std::vector<std::uint8_t>> layer_png(const std::string& name) const;
@@ -150,10 +176,11 @@ class LiveMap {
 
  private:
   mutable std::mutex mutex_;
-  std::vector<StoredScan> scans_;
+  std::vector<StoredScan> scans_;  // `placed` where the points in placed_ are
   // Each scan's points in the map frame, in the order of scans_: shared with the encoder
   // thread, never copied whole.
   std::vector<std::shared_ptr<const PointCloud>> placed_;
+  std::vector<std::uint8_t> in_map_;  // per scan: shown (not waiting outside the map)
   std::size_t point_count_ = 0;
   Bounds3 bounds_;  // of all points, kept as scans arrive: the session endpoint is polled often
   std::shared_ptr<const std::string> encoded_;  // the whole map up to encoded_last_scan_
@@ -166,7 +193,8 @@ class LiveMap {
   std::condition_variable encode_wanted_;            // with mutex_
   bool stopping_ = false;
   VoxelMap thinned_{kThinnedMapVoxelM};  // under encode_mutex_
-  std::map<std::int64_t, std::shared_ptr<const std::string>> chunks_;
+  // By scan id; null until made (encoded_chunk) after the scan moved.
+  mutable std::map<std::int64_t, std::shared_ptr<const std::string>> chunks_;
   std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> layers_;
   MapAreas areas_;
   std::map<std::int64_t, MapAreas> areas_after_;  // by scan id
@@ -183,6 +211,31 @@ class LiveMap {
   // The encoder thread: encodes the whole map whenever a scan has joined since the last time
   // (several scans that arrived meanwhile in one go).
   void encode_loop();
+
+  // The map's scans as mission_ has them now: each scan's pose, points (re-placed only when
+  // it moved past MissionConfig::replace_m / _deg: smaller moves are invisible at the map's
+  // scale and would re-send every chunk after every scan) and whether it is in the map.
+  // Needs encode_mutex_ held; `scans` are the scans in mission_'s order.
+  struct Followed {
+    std::vector<StoredScan> scans;
+    std::vector<std::shared_ptr<const PointCloud>> placed;
+    std::vector<std::uint8_t> in_map;
+    std::vector<Bounds3> bounds;
+    std::vector<std::int64_t> unencoded;  // ids whose chunk must be made anew
+    MapCorrected corrected;
+  };
+  Followed follow_mission(std::vector<StoredScan> scans,
+                          std::vector<std::shared_ptr<const PointCloud>> placed,
+                          std::vector<std::uint8_t> in_map) const;
+  // The thinned map of the scans in `f` that are in the map: made anew when `whole` (it cannot
+  // take a scan out), else the newest added. Needs encode_mutex_ held.
+  void rethin(const Followed& f, bool whole);
+  // Publishes `f`: scans, points, in-map flags, bounds and counts; the chunks of moved scans
+  // are dropped to be made anew. Needs mutex_ and encode_mutex_ held.
+  void commit(Followed f);
+  std::vector<Bounds3> scan_bounds_;  // per scan, of placed_
+  // Where scan `id` is in scans_. Needs mutex_ (or encode_mutex_) held.
+  std::optional<std::size_t> index_of(std::int64_t id) const;
 
   // Recomputes layers, areas and the plans from the pipeline and publishes them together with
   // whatever `commit` changes (run under mutex_); needs encode_mutex_ held. Returns the new

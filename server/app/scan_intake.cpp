@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 namespace scanplan::server {
 
@@ -50,7 +51,7 @@ void ScanIntake::start() {
         problem = "its stored pose is not a place: " + *why;
       } else {
         try {
-          process(s, load(s));
+          process(s, load(s), /*restoring=*/true);
         } catch (const std::exception& e) {
           problem = e.what();
         }
@@ -61,6 +62,13 @@ void ScanIntake::start() {
         not_in_map_.push_back({s.id, s.robot, problem});
       }
       ++rebuild_->done;
+    }
+    if (!existing.empty()) {
+      try {
+        resume_poses();
+      } catch (const std::exception& e) {
+        spdlog::error("the session's latest poses could not be read: {}", e.what());
+      }
     }
     {
       std::lock_guard lock(mutex_);
@@ -124,14 +132,15 @@ SubmittedScan ScanIntake::submit(const std::string& robot, const Pose& estimated
 }
 
 StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
-  const std::optional<MapMatch> matched = live_.place(cloud, scan.estimated);
+  const std::optional<MapMatch> matched = live_.place(cloud, scan.estimated, scan.robot);
   if (!matched) return scan;
   const MapMatch& m = *matched;
   const Pose& e = scan.estimated;
   const Pose& p = m.placed;
   scan.match = StoredMatch{m.applied,        m.result.converged,
                            m.result.method,  m.applied ? std::string() : m.result.message,
-                           m.result.time_ms, m.result.inlier_ratio};
+                           m.result.time_ms, m.result.inlier_ratio,
+                           m.information};
   // Refused, the match leaves the scan at its reported pose carried into the map frame.
   scan.placed = p;
   try {
@@ -160,11 +169,18 @@ StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
   return scan;
 }
 
-void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud) {
-  std::vector<PlanRecord> plans = live_.add(scan, cloud);
-  if (const auto chunk = live_.encoded_chunk(scan.id)) events_.map_chunk(scan.id, *chunk);
+void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud, bool restoring) {
+  LiveMap::Added added = live_.add(scan, cloud);
+  std::vector<PlanRecord>& plans = added.plans;
+  // A scan waiting outside the map is not shown: it may be metres off.
+  if (added.in_map) {
+    if (const auto chunk = live_.encoded_chunk(scan.id)) events_.map_chunk(scan.id, *chunk);
+  }
   const MapAreas a = live_.areas();
-  events_.publish("map_updated", map_updated_json(scan, a));
+  events_.publish("map_updated", map_updated_json(scan, a, added.in_map));
+  // Brought back after a restart, the graph retraces the corrections already recorded: the
+  // session gets one revision once all scans are back (resume_poses).
+  if (!restoring) record_correction(added.corrected);
   // One plan per robot that is not driving, by robot id; the scanning robot's first.
   std::sort(plans.begin(), plans.end(),
             [](const PlanRecord& p, const PlanRecord& q) { return p.robot < q.robot; });
@@ -172,6 +188,63 @@ void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud) {
                         [&](const PlanRecord& p) { return p.robot == scan.robot; });
   for (const PlanRecord& plan : plans) {
     events_.publish("plan_done", plan_done_json(plan));
+  }
+}
+
+void ScanIntake::record_correction(const MapCorrected& corrected) {
+  std::int64_t revision = 0;
+  if (!corrected.poses.empty()) {
+    try {
+      revision = session_.record_pose_revision(corrected.poses);
+    } catch (const SessionStoreError& failure) {
+      // The map moved all the same; a restart retraces the graph from the recorded matches.
+      const std::string message =
+          std::string("the corrected poses could not be recorded in the session: ") +
+          failure.what();
+      spdlog::error("{}", message);
+      {
+        std::lock_guard lock(mutex_);
+        storage_failure_ = StorageFailure{iso8601_utc_now(), message};
+      }
+      events_.publish("storage_failed", {{"message", message}});
+    }
+  }
+  if (corrected.empty()) return;
+  spdlog::info(
+      "map corrected (revision {}): {} scans moved up to {:.3f} m / {:.2f}°, {} joined, {} left",
+      revision, corrected.moved.size(), corrected.max_moved_m, corrected.max_turned_deg,
+      corrected.joined.size(), corrected.left.size());
+  events_.publish("map_corrected", map_corrected_json(corrected, revision));
+}
+
+void ScanIntake::resume_poses() {
+  // The graph rebuilt from the recorded matches should stand where the session's latest
+  // revision left it; where it does not (a revision lost to a full disk, a solver that settled
+  // differently), what the map now shows is recorded as a revision of its own.
+  std::map<std::int64_t, RevisedPose> recorded;
+  for (const RevisedPose& r : session_.latest_poses()) recorded[r.scan] = r;
+  const std::vector<std::int64_t> waiting = live_.waiting();
+  MapCorrected differ;
+  for (const StoredScan& s : live_.scans()) {
+    const bool in_map = !std::binary_search(waiting.begin(), waiting.end(), s.id);
+    const auto it = recorded.find(s.id);
+    const Pose was = it == recorded.end() ? session_.scan(s.id)->placed : it->second.pose;
+    const bool was_in = it == recorded.end() || it->second.in_map;
+    const double moved = std::hypot(s.placed.x - was.x, s.placed.y - was.y, s.placed.z - was.z);
+    if (moved > kResumeToleranceM || in_map != was_in) {
+      differ.poses.push_back({s.id, s.placed, in_map});
+      differ.max_moved_m = std::max(differ.max_moved_m, moved);
+    }
+  }
+  if (differ.poses.empty()) return;
+  spdlog::warn(
+      "{} scans are not where the session's latest poses had them (up to {:.3f} m): "
+      "recorded as a new revision",
+      differ.poses.size(), differ.max_moved_m);
+  try {
+    session_.record_pose_revision(differ.poses);
+  } catch (const SessionStoreError& failure) {
+    spdlog::error("the resumed poses could not be recorded: {}", failure.what());
   }
 }
 

@@ -108,8 +108,15 @@ class ScanIntake {
 
  private:
   void loop();
-  // Brings one stored scan into the live map and tells the browsers.
-  void process(const StoredScan& scan, const PointCloud& cloud);
+  // Brings one stored scan into the live map and tells the browsers; what the pose graph
+  // changed is recorded and published unless `restoring` (a restart retracing the session).
+  void process(const StoredScan& scan, const PointCloud& cloud, bool restoring = false);
+  // A correction of the map: a revision of the poses in the session and `map_corrected`.
+  void record_correction(const MapCorrected& corrected);
+  // After a restart: records the poses where they differ from the session's latest revision.
+  void resume_poses();
+  // A scan brought back within this of its recorded pose is where it was.
+  static constexpr double kResumeToleranceM = 0.02;
   // Matches a new scan against the map so far (paper §4) and records where it goes.
   StoredScan match(StoredScan scan, const PointCloud& cloud);
 

@@ -1,5 +1,8 @@
 #include "event_text.hpp"
 
+#include <string>
+#include <vector>
+
 #include "text_format.hpp"
 
 namespace scanplan::cli {
@@ -72,6 +75,51 @@ std::string match_done(const json& e) {
   return with_message(text, e);
 }
 
+// Scan ids as runs: [3, 4, 5, 6, 9] -> "3–6, 9".
+std::string id_runs(const json& ids) {
+  std::vector<long long> v;
+  if (ids.is_array()) {
+    for (const json& id : ids) {
+      if (id.is_number_integer()) v.push_back(id.get<long long>());
+    }
+  }
+  std::string out;
+  for (std::size_t i = 0; i < v.size();) {
+    std::size_t j = i;
+    while (j + 1 < v.size() && v[j + 1] == v[j] + 1) ++j;
+    if (!out.empty()) out += ", ";
+    out += std::to_string(v[i]);
+    if (j > i) out += "\u2013" + std::to_string(v[j]);
+    i = j + 1;
+  }
+  return out;
+}
+
+std::size_t count_of(const json& e, const char* key) {
+  const auto it = e.find(key);
+  return it != e.end() && it->is_array() ? it->size() : 0;
+}
+
+// "map corrected: scans 3–9 moved up to 12 cm / 0.1°; scan 14 tied into the map".
+std::string map_corrected(const json& e) {
+  std::vector<std::string> parts;
+  const auto scans = [&](const char* key) {
+    return (count_of(e, key) == 1 ? "scan " : "scans ") + id_runs(e.at(key));
+  };
+  if (count_of(e, "scans") > 0) {
+    parts.push_back(scans("scans") + " moved up to " + fixed(100 * num(e, "max_moved_m"), 0) +
+                    " cm / " + fixed(num(e, "max_turned_deg"), 1) + " deg");
+  }
+  if (count_of(e, "joined") > 0) parts.push_back(scans("joined") + " tied into the map");
+  if (count_of(e, "left") > 0) {
+    parts.push_back(scans("left") + " set outside the map (its match no longer agrees)");
+  }
+  std::string text = "map corrected:";
+  for (std::size_t i = 0; i < parts.size(); ++i) text += (i ? "; " : " ") + parts[i];
+  if (num(e, "revision") > 0) text += " (pose revision " + str(e, "revision") + ")";
+  return text;
+}
+
 std::string mission(const json& e) {
   const std::string kind = str(e, "kind");
   const std::string candidate = "candidate " + str(e, "candidate");
@@ -132,8 +180,12 @@ std::string describe_event(const json& e) {
   if (type == "scan_received") return scan_received(e);
   if (type == "scan_rejected") return scan_rejected(e);
   if (type == "match_done") return match_done(e);
+  if (type == "map_corrected") return map_corrected(e);
   if (type == "map_updated") {
-    return "scan " + str(e, "scan") + " is in the map: completed " +
+    const bool waiting = !e.value("in_map", true);
+    return "scan " + str(e, "scan") +
+           (waiting ? " waits outside the map until a match ties it in: completed "
+                    : " is in the map: completed ") +
            fixed(num(e, "completed_m2"), 0) + " m2, low-res " +
            fixed(num(e, "low_resolution_m2"), 0) + " m2, unscanned " +
            fixed(num(e, "unscanned_m2"), 0) + " m2, movable " + fixed(num(e, "movable_m2"), 0) +

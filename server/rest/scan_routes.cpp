@@ -93,7 +93,7 @@ Response Api::post_scan(const Request& request) {
                          .count();
   try {
     const SubmittedScan s = app_.intake.submit(robot, estimated, stamp, std::move(cloud));
-    json answer = scan_json(s.scan, std::nullopt);
+    json answer = scan_json(s.scan, std::nullopt, /*in_map=*/false);  // not processed yet
     answer["dropped"] = dropped_json(s.dropped);
     return Response::json(201, answer);
   } catch (const InvalidScanError& e) {
@@ -108,11 +108,14 @@ Response Api::post_scan(const Request& request) {
 
 Response Api::list_scans() const {
   json list = json::array();
-  for (const StoredScan& s : app_.map.scans())
-    list.push_back(scan_json(s, app_.map.areas_after(s.id)));
+  const std::vector<std::int64_t> waiting = app_.map.waiting();
+  for (const StoredScan& s : app_.map.scans()) {
+    const bool in_map = !std::binary_search(waiting.begin(), waiting.end(), s.id);
+    list.push_back(scan_json(s, app_.map.areas_after(s.id), in_map));
+  }
   json excluded = json::array();
   for (const StoredScan& s : app_.intake.excluded_scans()) {
-    excluded.push_back(scan_json(s, app_.map.areas_after(s.id)));
+    excluded.push_back(scan_json(s, app_.map.areas_after(s.id), false));
   }
   return Response::json(200, {{"scans", list},
                               {"pending", app_.intake.pending()},
@@ -135,7 +138,7 @@ Response Api::set_scan_excluded(const Request& request, const std::string& id, b
   const std::string reason = rest::text_in(body, "reason", rest::kMaxReasonBytes, TextKind::kProse);
   try {
     const StoredScan s = app_.intake.set_excluded(n, excluded, by, reason);
-    return Response::json(200, scan_json(s, app_.map.areas_after(s.id)));
+    return Response::json(200, scan_json(s, app_.map.areas_after(s.id), !excluded));
   } catch (const ExclusionError& e) {
     throw HttpError(e.code == "not_found" ? 404 : 409, e.code, e.what());
   } catch (const SessionStoreError& e) {
@@ -146,11 +149,14 @@ Response Api::set_scan_excluded(const Request& request, const std::string& id, b
 
 Response Api::get_scan(const std::string& id) const {
   const auto n = static_cast<std::int64_t>(rest::path_id(id, "a scan id"));
+  const std::vector<std::int64_t> waiting = app_.map.waiting();
   for (const StoredScan& s : app_.map.scans()) {
-    if (s.id == n) return Response::json(200, scan_json(s, app_.map.areas_after(s.id)));
+    if (s.id != n) continue;
+    const bool in_map = !std::binary_search(waiting.begin(), waiting.end(), s.id);
+    return Response::json(200, scan_json(s, app_.map.areas_after(s.id), in_map));
   }
   for (const StoredScan& s : app_.intake.excluded_scans()) {
-    if (s.id == n) return Response::json(200, scan_json(s, app_.map.areas_after(s.id)));
+    if (s.id == n) return Response::json(200, scan_json(s, app_.map.areas_after(s.id), false));
   }
   throw HttpError(404, "not_found", "no scan " + id + " in this session");
 }

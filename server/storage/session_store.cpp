@@ -9,6 +9,8 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <fstream>
@@ -70,6 +72,11 @@ class Statement {
     return check(
         sqlite3_bind_text(stmt_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT));
   }
+  // For the next row of a statement run once per row.
+  void reset() {
+    sqlite3_reset(stmt_);
+    sqlite3_clear_bindings(stmt_);
+  }
   bool step() {
     const int rc = sqlite3_step(stmt_);
     if (rc == SQLITE_ROW) return true;
@@ -102,10 +109,38 @@ constexpr const char* kScanColumns =
 const std::string kScanSelect =
     std::string("SELECT ") + kScanColumns +
     ", applied, converged, method, matches.reason, time_ms, inlier_ratio, "
-    "ex.excluded, ex.actor, ex.reason, ex.at FROM scans LEFT JOIN matches "
+    "ex.excluded, ex.actor, ex.reason, ex.at, matches.information FROM scans LEFT JOIN matches "
     "ON matches.scan_id = scans.id LEFT JOIN (SELECT scan_id, excluded, actor, reason, at FROM "
     "exclusions WHERE id IN (SELECT MAX(id) FROM exclusions GROUP BY scan_id)) ex "
     "ON ex.scan_id = scans.id";
+
+// A match's 4×4 information as stored: 16 numbers, row-major, separated by spaces (round-trip
+// precision). Anything else reads as zero: the match then ties its scan in only weakly.
+std::string information_text(const Eigen::Matrix4d& m) {
+  std::string out;
+  char number[32];
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      std::snprintf(number, sizeof number, "%.17g", m(r, c));
+      if (!out.empty()) out += ' ';
+      out += number;
+    }
+  }
+  return out;
+}
+
+Eigen::Matrix4d information_from_text(const std::string& text) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
+  const char* at = text.c_str();
+  for (int k = 0; k < 16; ++k) {
+    char* end = nullptr;
+    const double v = std::strtod(at, &end);
+    if (end == at || !std::isfinite(v)) return Eigen::Matrix4d::Zero();
+    m(k / 4, k % 4) = v;
+    at = end;
+  }
+  return m;
+}
 
 StoredScan scan_from_row(const Statement& s) {
   StoredScan r;
@@ -122,6 +157,7 @@ StoredScan scan_from_row(const Statement& s) {
                           s.text(21),         s.real(22),         s.real(23)};
   }
   if (!s.null(24) && s.integer(24) != 0) r.excluded = Exclusion{s.text(25), s.text(26), s.text(27)};
+  if (r.match && !s.null(28)) r.match->information = information_from_text(s.text(28));
   return r;
 }
 
@@ -214,6 +250,15 @@ SessionStore::SessionStore(std::filesystem::path dir) : dir_(created(std::move(d
       "x REAL NOT NULL, y REAL NOT NULL, z REAL NOT NULL, text TEXT NOT NULL, "
       "author TEXT NOT NULL, created_ns INTEGER NOT NULL, created_at TEXT NOT NULL, "
       "deleted_at TEXT, deleted_by TEXT)");
+  // Sessions recorded before the pose graph have no information column.
+  if (!has_column("matches", "information"))
+    exec("ALTER TABLE matches ADD COLUMN information TEXT");
+  // Every pose the graph gave a scan, by revision: the session's history of corrections.
+  exec(
+      "CREATE TABLE IF NOT EXISTS pose_revisions(revision INTEGER NOT NULL, scan_id INTEGER NOT "
+      "NULL REFERENCES scans(id), x REAL NOT NULL, y REAL NOT NULL, z REAL NOT NULL, roll REAL "
+      "NOT NULL, pitch REAL NOT NULL, yaw REAL NOT NULL, in_map INTEGER NOT NULL, at TEXT NOT "
+      "NULL, PRIMARY KEY(revision, scan_id))");
   // Every exclusion and restoration, in order: the latest row per scan is its state.
   exec(
       "CREATE TABLE IF NOT EXISTS exclusions(id INTEGER PRIMARY KEY, scan_id INTEGER NOT NULL "
@@ -242,6 +287,14 @@ void SessionStore::rollback() const {
   // SQLite may have rolled the transaction back itself (a full disk: SQLITE_FULL); a second
   // rollback would then fail and hide the error that matters.
   if (sqlite3_get_autocommit(db_) == 0) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+}
+
+bool SessionStore::has_column(const char* table, const char* column) const {
+  Statement s(db_, (std::string("PRAGMA table_info(") + table + ")").c_str());
+  while (s.step()) {
+    if (s.text(1) == column) return true;
+  }
+  return false;
 }
 
 void SessionStore::exec(const char* sql) const {
@@ -329,9 +382,10 @@ void SessionStore::record_match(std::int64_t id, const StoredMatch& m, const Pos
   try {
     Statement ins(db_,
                   "INSERT OR REPLACE INTO matches(scan_id, applied, converged, method, reason, "
-                  "time_ms, inlier_ratio) VALUES(?,?,?,?,?,?,?)");
+                  "time_ms, inlier_ratio, information) VALUES(?,?,?,?,?,?,?,?)");
     ins.bind(1, id).bind(2, std::int64_t{m.applied}).bind(3, std::int64_t{m.converged});
     ins.bind(4, m.method).bind(5, m.reason).bind(6, m.time_ms).bind(7, m.inlier_ratio);
+    ins.bind(8, information_text(m.information));
     ins.step();
     Statement s(db_,
                 "UPDATE scans SET x = ?, y = ?, z = ?, roll = ?, pitch = ?, yaw = ? WHERE id = ?");
@@ -343,6 +397,58 @@ void SessionStore::record_match(std::int64_t id, const StoredMatch& m, const Pos
     rollback();
     throw;
   }
+}
+
+std::int64_t SessionStore::record_pose_revision(const std::vector<RevisedPose>& poses) {
+  std::lock_guard lock(mutex_);
+  exec("BEGIN IMMEDIATE");
+  try {
+    std::int64_t revision = 0;
+    {
+      Statement next(db_, "SELECT COALESCE(MAX(revision), 0) + 1 FROM pose_revisions");
+      next.step();
+      revision = next.integer(0);
+    }
+    const std::string at = utc_now();
+    Statement ins(db_,
+                  "INSERT INTO pose_revisions(revision, scan_id, x, y, z, roll, pitch, yaw, "
+                  "in_map, at) VALUES(?,?,?,?,?,?,?,?,?,?)");
+    for (const RevisedPose& r : poses) {
+      const Pose& p = r.pose;
+      ins.reset();
+      ins.bind(1, revision).bind(2, r.scan).bind(3, p.x).bind(4, p.y).bind(5, p.z);
+      ins.bind(6, p.roll).bind(7, p.pitch).bind(8, p.yaw).bind(9, std::int64_t{r.in_map});
+      ins.bind(10, at);
+      ins.step();
+    }
+    exec("COMMIT");
+    return revision;
+  } catch (...) {
+    rollback();
+    throw;
+  }
+}
+
+std::vector<RevisedPose> SessionStore::latest_poses() const {
+  std::lock_guard lock(mutex_);
+  std::vector<RevisedPose> out;
+  Statement s(db_,
+              "SELECT scan_id, x, y, z, roll, pitch, yaw, in_map FROM pose_revisions WHERE "
+              "(scan_id, revision) IN (SELECT scan_id, MAX(revision) FROM pose_revisions GROUP "
+              "BY scan_id) ORDER BY scan_id");
+  while (s.step()) {
+    out.push_back({s.integer(0),
+                   {s.real(1), s.real(2), s.real(3), s.real(4), s.real(5), s.real(6)},
+                   s.integer(7) != 0});
+  }
+  return out;
+}
+
+std::int64_t SessionStore::pose_revision() const {
+  std::lock_guard lock(mutex_);
+  Statement s(db_, "SELECT COALESCE(MAX(revision), 0) FROM pose_revisions");
+  s.step();
+  return s.integer(0);
 }
 
 std::optional<StoredScan> SessionStore::set_excluded(std::int64_t id, bool excluded,

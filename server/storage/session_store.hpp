@@ -1,5 +1,6 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -30,6 +31,18 @@ struct StoredMatch {
   std::string reason;      // why it was not applied (empty when it was)
   double time_ms = 0;
   double inlier_ratio = 0;
+  // How firmly the match fixes x, y, z and yaw (MapMatch::information, map frame): the pose
+  // graph weighs the match by it when the session is brought back. Zero in sessions recorded
+  // before the graph (such a match ties its scan in only weakly).
+  Eigen::Matrix4d information = Eigen::Matrix4d::Zero();
+};
+
+// A scan's pose as one revision of the pose graph left it (issue 17): in the map frame, and
+// whether the scan was in the map or still waiting for a match that ties it in.
+struct RevisedPose {
+  std::int64_t scan = 0;
+  Pose pose;
+  bool in_map = true;
 };
 
 // The operator took the scan out of the map (DELETE /api/v1/scans/{id}): who, why, when. The
@@ -107,6 +120,14 @@ class SessionStore {
   // Takes scan `id` out of the map (`excluded`) or puts it back, recorded with who and why (the
   // full history is kept; scans() carries the latest). Returns the scan as it now stands;
   // nothing for an unknown id.
+  // Records a revision of the scans' poses (the pose graph moved them): the scans named, at
+  // their new poses, in one transaction. Returns the revision's number (1, 2, ...). Every
+  // revision is kept.
+  std::int64_t record_pose_revision(const std::vector<RevisedPose>& poses);
+  // Each scan's pose in its latest revision, by scan id (scans never revised are missing).
+  std::vector<RevisedPose> latest_poses() const;
+  // The number of the latest revision; 0 before the first.
+  std::int64_t pose_revision() const;
   std::optional<StoredScan> set_excluded(std::int64_t id, bool excluded, const std::string& by,
                                          const std::string& reason);
   std::vector<StoredScan> scans() const;
@@ -132,6 +153,7 @@ class SessionStore {
 
  private:
   void exec(const char* sql) const;
+  bool has_column(const char* table, const char* column) const;
   // Ends a failed transaction, if SQLite has not already; never throws.
   void rollback() const;
   // Removes unfinished writes and sets aside PLYs without a row (see the class comment).

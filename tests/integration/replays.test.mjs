@@ -17,7 +17,8 @@ test('there are replay scripts', () => assert.ok(scripts.length > 0));
 
 for (const script of scripts) {
   test(`replay ${script.slice(root.length + 1)}`, { timeout: 180000 }, async () => {
-    const stack = await startStack({ bridge: false });
+    // The scripts' reported poses are absolute fixes with bounded noise (σ 1 m, 5°), not odometry.
+    const stack = await startStack({ bridge: false, odometry: 'absolute' });
     try {
       const run = spawnSync(requireEnv('SCANPLAN_CLI'),
         ['replay', script, '--server', stack.url, '--token', stack.token], { encoding: 'utf8' });

@@ -60,17 +60,28 @@ async function waitFor(what, fn, timeoutMs, procs = []) {
   }
 }
 
-export async function startStack({ world, replay, timeScale = 600, seed = 1, bridge: withBridge = true,
+// The server's --odometry for a world file's pose_noise: exact when an absolute model has no
+// noise at all.
+export function odometryOf(worldFile) {
+  const noise = JSON.parse(readFileSync(worldFile, 'utf8')).pose_noise ?? {};
+  if (noise.model !== 'absolute') return 'drift';
+  const exact = ['xy_sigma_m', 'z_sigma_m', 'yaw_sigma_deg'].every((k) => noise[k] === 0);
+  return exact ? 'exact' : 'absolute';
+}
+
+export async function startStack({ world, replay, odometry: odometryArg, timeScale = 600, seed = 1, bridge: withBridge = true,
                                    dir = mkdtempSync(join(tmpdir(), 'scanplan-test-')), tokens } = {}) {
   const domain = requireEnv('SCANPLAN_TEST_DOMAIN');
   const token = tokens?.operator ?? randomBytes(16).toString('hex');
   const viewerToken = tokens?.viewer ?? randomBytes(16).toString('hex');
   const worldFile = world ?? join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples/worlds/yard.json');
+  // The server is told the robots' pose sensors, as an operator would configure it.
+  const odometry = odometryArg ?? (replay ? 'absolute' : odometryOf(worldFile));
 
   const server = startProcess(
     requireEnv('SCANPLAN_SERVER'),
     ['--session', join(dir, 'session'), '--listen', '127.0.0.1:0', '--domain', domain,
-     '--web', requireEnv('SCANPLAN_WEB_DIR')],
+     '--web', requireEnv('SCANPLAN_WEB_DIR'), '--odometry', odometry],
     { SCANPLAN_OPERATOR_TOKEN: token, SCANPLAN_VIEWER_TOKEN: viewerToken }, 'scanplan-server');
   const launchBridge = (extraArgs = []) => startProcess(
     requireEnv('SCANPLAN_BRIDGE'),

@@ -127,7 +127,13 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
     return;
   }
   const std::vector<Pose> before = poses_;
+  const std::optional<SensorFix> fix = where.matched ? std::nullopt : sensors_place(where);
   GraphUpdate update = graph_->add(scan, where, where.matched && unsure(where));
+  const std::size_t k = placed_.size() - 1;
+  if (fix && !graph_->anchored(k)) {
+    graph_->anchor_by_sensors(k, fix->from, fix->information);
+    update.solve = graph_->solve();
+  }
   follow_graph();
   if (rematch_refused(update)) follow_graph();
   last_correction_ = correction(update, before);
@@ -154,6 +160,36 @@ PointCloud MissionPipeline::own_frame(std::size_t i) const {
     own.push_back(own_from_map * in_map.points[p], in_map.colors[p]);
   }
   return own;
+}
+
+// A scan no match placed joins the map all the same where the pose sensors place it within the
+// accuracy the map is built to (3σ within kSensorsPlaceM / _Deg): an exact simulation, a total
+// station, or a drive of a few decimetres on odometry from a placed scan. Anywhere else it
+// waits for a match: a scan placed metres off makes phantom walls and steps.
+std::optional<MissionPipeline::SensorFix> MissionPipeline::sensors_place(
+    const Placement& where) const {
+  if (placed_.size() <= 1) return std::nullopt;  // the first scan is the map frame
+  const PoseNoise& noise = config_.pose_noise;
+  MoveUncertainty u;
+  std::size_t from = 0;
+  if (noise.model == OdometryModel::kAbsolute) {
+    // Two independent fixes: the first scan's and this one's.
+    u = {std::sqrt(2.0) * noise.xy_sigma_m, std::sqrt(2.0) * noise.z_sigma_m,
+         std::sqrt(2.0) * noise.yaw_sigma_deg};
+  } else {
+    const auto last = graph_->last_anchored_of(where.track);
+    const auto prior = graph_->prior_uncertainty(where.track, where.reported);
+    if (!last || !prior) return std::nullopt;
+    u = *prior;
+    from = *last;
+  }
+  if (3 * u.xy_m > kSensorsPlaceM || 3 * u.yaw_deg > kSensorsPlaceDeg) return std::nullopt;
+  // σ never below what the scanner itself resolves: an exact simulation is no infinitely sure
+  // edge.
+  const double xy = std::max(u.xy_m, 0.005), z = std::max(u.z_m, 0.005);
+  const double yaw = deg2rad(std::max(u.yaw_deg, 0.01));
+  const Eigen::Vector4d sigma(xy, xy, z, yaw);
+  return SensorFix{from, sigma.cwiseAbs2().cwiseInverse().asDiagonal()};
 }
 
 // Whether a match is to wait for confirmation (ScanGraph::offer_match_to_map): it moved the scan

@@ -310,6 +310,17 @@ void ScanGraph::update_anchors(const GraphSolveReport& solve) {
   }
 }
 
+void ScanGraph::anchor_by_sensors(std::size_t k, std::size_t from,
+                                  const Eigen::Matrix4d& information) {
+  // Trusted like odometry (no robust loss): the sensors were judged good enough to place it.
+  add_match_edge({from, k, relative_pose(reported_.at(from), reported_.at(k)), information,
+                  EdgeKind::kOdometry},
+                 "sensors", k);
+  anchored_[k] = 1;
+  uncertain_[k] = MoveUncertainty{};
+  pending_[k].clear();
+}
+
 void ScanGraph::add_match_edge(const GraphEdge& edge, const char* origin, std::size_t anchors) {
   graph_.add_edge(edge);
   origins_.emplace_back(origin);

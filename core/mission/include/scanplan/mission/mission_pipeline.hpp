@@ -151,6 +151,15 @@ class MissionPipeline {
   // tried again when more do.
   std::vector<std::size_t> anchored_near_;
 
+  // The pose sensors place a scan closely enough by themselves when 3σ of their error is
+  // within this: the accuracy the map is built to (issue 17's target).
+  static constexpr double kSensorsPlaceM = 0.05;
+  static constexpr double kSensorsPlaceDeg = 0.1;
+  struct SensorFix {
+    std::size_t from = 0;  // the scan the sensors relate it to
+    Eigen::Matrix4d information;
+  };
+  std::optional<SensorFix> sensors_place(const Placement& where) const;
   bool rematch_refused(GraphUpdate& update);
   bool unsure(const Placement& where) const;
   bool beyond_reach(const MoveUncertainty& u) const;

@@ -109,6 +109,11 @@ class ScanGraph {
   // match, lies where the odometry between the two says (confirm_by_odometry). Call solve()
   // after.
   void offer_match_to_map(std::size_t scan, const Pose& placed, const Eigen::Matrix4d& information);
+  // The pose sensors alone place scan `scan` closely enough (MissionPipeline::sensors_place):
+  // it is tied to scan `from` (the first scan for an absolute fix, the robot's last anchored
+  // scan for a short drive on odometry) by what the sensors reported, with their information.
+  // Call solve() after.
+  void anchor_by_sensors(std::size_t scan, std::size_t from, const Eigen::Matrix4d& information);
   GraphSolveReport solve();
 
   std::size_t size() const { return graph_.size(); }
@@ -138,7 +143,7 @@ class ScanGraph {
   // How each edge of graph() came about, by index: "odometry", "pair-search" (a pairwise match,
   // the search first: one end was not anchored), "map" (a scan-to-map match when the scan came),
   // "map-confirmed" (one beyond the sensors' reach, confirmed by the odometry to the robot's
-  // next or previous scan), "rematch" (one later).
+  // next or previous scan), "rematch" (one later), "sensors" (anchor_by_sensors).
   const std::string& edge_origin(std::size_t edge) const { return origins_.at(edge); }
   const ScanGraphConfig& config() const { return config_; }
 
