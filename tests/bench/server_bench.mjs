@@ -44,7 +44,8 @@ function rssKb(pid) {
   return { rss: field('VmRSS'), hwm: field('VmHWM') };
 }
 
-const stack = await startStack({ bridge: false, dir: join(work, 'stack') });
+// The reported poses are absolute fixes disturbed by σ 1 m / 5° (below), and the server is told so.
+const stack = await startStack({ bridge: false, odometry: 'absolute', dir: join(work, 'stack') });
 const ws = new WebSocket(`${stack.url.replace('http', 'ws')}/api/v1/events?token=${stack.viewerToken}`);
 await new Promise((resolve, reject) => { ws.on('open', resolve); ws.on('error', reject); });
 const waiting = [];

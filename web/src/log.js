@@ -4,6 +4,34 @@
 const MAX = 300;
 const f1 = (v) => (Number.isFinite(v) ? v.toFixed(1) : '?');
 
+// [3, 4, 5, 9] -> "3–5, 9"
+function runs(ids) {
+  const v = [...ids].sort((a, b) => a - b);
+  const out = [];
+  for (let i = 0; i < v.length; ) {
+    let j = i;
+    while (j + 1 < v.length && v[j + 1] === v[j] + 1) j++;
+    out.push(j > i ? `${v[i]}\u2013${v[j]}` : `${v[i]}`);
+    i = j + 1;
+  }
+  return out.join(', ');
+}
+
+function scans(ids) {
+  return `${ids.length === 1 ? 'scan' : 'scans'} ${runs(ids)}`;
+}
+
+// "map corrected: scans 3–9 moved up to 12 cm"
+function mapCorrected(e) {
+  const parts = [];
+  if (e.scans?.length) {
+    parts.push(`${scans(e.scans)} moved up to ${Math.round(100 * (e.max_moved_m ?? 0))} cm / ${f1(e.max_turned_deg)}°`);
+  }
+  if (e.joined?.length) parts.push(`${scans(e.joined)} tied into the map`);
+  if (e.left?.length) parts.push(`${scans(e.left)} set outside the map until a match agrees`);
+  return `map corrected: ${parts.join('; ')}`;
+}
+
 function describe(e) {
   const who = e.candidate != null ? `#${e.candidate}` : '';
   switch (e.kind) {
@@ -31,6 +59,8 @@ function describe(e) {
       return `took scan ${e.scan} out of the map${e.reason ? `: ${e.reason}` : ''}`;
     case 'scan_restored':
       return `put scan ${e.scan} back into the map`;
+    case 'map_corrected':
+      return mapCorrected(e);
     case 'goal':
       return `proposed custom point ${who} at (${f1(e.x)}, ${f1(e.y)}), F ${Math.round(e.f ?? 0)}`;
     default:

@@ -286,7 +286,8 @@ async function refreshScans() {
     topView.setScans(state.scans);
     mission.setScans(state.scans);
     render();
-    if (view) await chunks.sync(state.scans.map((s) => s.id));
+    // A scan waiting for a match that ties it in may be metres off: not drawn until it joins.
+    if (view) await chunks.sync(state.scans.filter((s) => s.in_map !== false).map((s) => s.id));
   } catch (e) {
     if (!toError(e).network) console.warn('scans:', e);
   }
@@ -421,6 +422,16 @@ function onEvent(e) {
     case 'scan_excluded':
     case 'scan_restored':
       log.add({ ...e, kind: e.type });
+      break;
+    case 'map_corrected':
+      log.add({ ...e, kind: 'map_corrected' });
+      chunks.forget([...(e.scans || []), ...(e.joined || [])]);
+      soon(() => {
+        refreshSession();
+        refreshScans();
+        refreshLayer();
+        refreshCandidates();
+      });
       break;
     case 'map_rebuilt':
       soon(() => {

@@ -19,6 +19,7 @@ export class MapChunks {
     this.onRemove = onRemove;
     this.held = new Set(); // scan ids in the view
     this.pending = new Set(); // being fetched or decoded
+    this.stale = new Set(); // pending, but the scan moved since: fetched again once in
     this.failed = new Map(); // scan id -> message
     this.syncing = false;
     this.resyncWanted = null;
@@ -83,7 +84,8 @@ export class MapChunks {
     try {
       const d = await this._decode(buffer, id);
       this.pending.delete(id);
-      this.held.add(id);
+      // Drawn all the same (nearer than nothing); the next sync fetches it where it now is.
+      if (!this.stale.delete(id)) this.held.add(id);
       this.failed.delete(id);
       this.onChunk({ id, count: d.count, positions: d.positions, colors: d.colors, min: d.min, max: d.max, source });
     } catch (e) {
@@ -92,6 +94,18 @@ export class MapChunks {
       this.error = e;
     }
     this.onChange();
+  }
+
+  /**
+   * The pose graph moved these scans (`map_corrected`): the chunks drawn stay until the next
+   * sync brings each one where it now is (replacing it in the view).
+   */
+  forget(ids) {
+    for (const id of ids) {
+      this.held.delete(id);
+      this.failed.delete(id);
+      if (this.pending.has(id)) this.stale.add(id);
+    }
   }
 
   /** A binary frame from the WebSocket (op 1). */

@@ -90,6 +90,40 @@ TEST_F(SessionDir, MatchOutcomesAndPlacementsSurviveReopening) {
   EXPECT_EQ(s.scan(2)->match->inlier_ratio, 0.31);
 }
 
+// The pose graph weighs a match by its information when the session is brought back, and every
+// revision of the poses it made is kept, the latest per scan read back.
+TEST_F(SessionDir, MatchInformationAndPoseRevisionsSurviveReopening) {
+  Pose est, first, second;
+  first.x = 2.5;
+  second.x = 2.53;
+  second.yaw = 0.1;
+  Eigen::Matrix4d information;
+  information << 1e5, 2, 3, 4, 2, 2e5, 0.1, 0.2, 3, 0.1, 3e5, 1.0 / 3, 4, 0.2, 1.0 / 3, 7e4;
+  {
+    SessionStore s(dir_);
+    EXPECT_EQ(s.pose_revision(), 0);
+    EXPECT_TRUE(s.latest_poses().empty());
+    s.add_scan("robot1", est, est, 1, cloud_of(10, 0));
+    s.add_scan("robot1", est, est, 2, cloud_of(10, 0));
+    StoredMatch m{true, true, "search-gicp", "", 50, 0.4};
+    m.information = information;
+    s.record_match(2, m, first);
+    EXPECT_EQ(s.record_pose_revision({{2, first, false}}), 1);
+    EXPECT_EQ(s.record_pose_revision({{1, est, true}, {2, second, true}}), 2);
+  }
+  SessionStore s(dir_);
+  ASSERT_TRUE(s.scan(2)->match);
+  EXPECT_EQ(s.scan(2)->match->information, information) << "to the last bit";
+  EXPECT_EQ(s.scan(2)->placed.x, 2.5) << "the match's own placement stays the evidence";
+  EXPECT_EQ(s.pose_revision(), 2);
+  const auto latest = s.latest_poses();
+  ASSERT_EQ(latest.size(), 2u);
+  EXPECT_EQ(latest[1].scan, 2);
+  EXPECT_DOUBLE_EQ(latest[1].pose.x, 2.53);
+  EXPECT_DOUBLE_EQ(latest[1].pose.yaw, 0.1);
+  EXPECT_TRUE(latest[1].in_map);
+}
+
 TEST_F(SessionDir, EventsReadBackNewestLimitOldestFirst) {
   {
     SessionStore s(dir_);
