@@ -114,7 +114,7 @@ LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
   // Writers take turns on encode_mutex_; readers only wait for the short commit below, and
   // they see the scan, its points, its chunk and the plan that includes it appear together.
   std::lock_guard encode_lock(encode_mutex_);
-  mission_.add(cloud, placement_of(scan), shared);
+  mission_.join(cloud, placement_of(scan), shared);
   // Only writers change the scans, under encode_mutex_ (held): read without mutex_.
   std::vector<StoredScan> scans = scans_;
   std::vector<std::shared_ptr<const PointCloud>> placed = placed_;
@@ -122,9 +122,10 @@ LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
   scans.push_back(scan);
   placed.push_back(shared);
   in_map.push_back(0);
-  Followed f = follow_mission(std::move(scans), std::move(placed), std::move(in_map));
+  Followed f = follow_mission(std::move(scans), std::move(placed), std::move(in_map),
+                              /*with_new_scan=*/true);
   rethin(f, /*whole=*/!f.corrected.empty());
-  for (const StoredScan& s : f.scans) scan_pose_of_[s.robot] = s.placed;
+  follow_robots(f);
   last_scan_ = {scan.id, scan.robot};
   Added out;
   out.corrected = f.corrected;
@@ -144,12 +145,49 @@ LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
   return out;
 }
 
+LiveMap::Refined LiveMap::refine() {
+  std::lock_guard encode_lock(encode_mutex_);
+  if (!mission_.refine()) return {};
+  Followed f = follow_mission(scans_, placed_, in_map_, /*with_new_scan=*/false);
+  Refined out;
+  out.corrected = f.corrected;
+  if (f.corrected.empty()) {
+    // Nothing an operator or the planner could see moved; the poses are kept all the same.
+    std::lock_guard lock(mutex_);
+    commit(std::move(f), /*map_changed=*/false);
+    return out;
+  }
+  rethin(f, /*whole=*/true);
+  follow_robots(f);
+  out.plans = refresh_derived([&] { commit(std::move(f)); });
+  encode_wanted_.notify_one();
+  if (on_map) on_map(thinned_.cloud());
+  if (on_plan) {
+    for (const PlanRecord& plan : out.plans) on_plan(plan);
+  }
+  return out;
+}
+
+void LiveMap::follow_robots(const Followed& f) {
+  // A robot stands where it last scanned; while that scan waits outside the map (metres off,
+  // perhaps), it is planned from its latest scan in the map, as the map can place it.
+  std::map<std::string, std::pair<Pose, bool>> at;
+  for (std::size_t i = 0; i < f.scans.size(); ++i) {
+    auto [it, fresh] = at.try_emplace(f.scans[i].robot, f.scans[i].placed, f.in_map[i] != 0);
+    if (!fresh && (f.in_map[i] || !it->second.second)) {
+      it->second = {f.scans[i].placed, f.in_map[i] != 0};
+    }
+  }
+  for (const auto& [robot, pose] : at) scan_pose_of_[robot] = pose.first;
+}
+
 LiveMap::Followed LiveMap::follow_mission(std::vector<StoredScan> scans,
                                           std::vector<std::shared_ptr<const PointCloud>> placed,
-                                          std::vector<std::uint8_t> in_map) const {
+                                          std::vector<std::uint8_t> in_map,
+                                          bool with_new_scan) const {
   Followed f;
   const MissionConfig& config = mission_.config();
-  const std::size_t newest = scans.size() - 1;
+  const std::size_t newest = with_new_scan ? scans.size() - 1 : scans.size();
   for (std::size_t i = 0; i < scans.size(); ++i) {
     const Pose& now = mission_.poses()[i];
     const bool now_in = mission_.in_map(i);
@@ -202,7 +240,7 @@ void LiveMap::rethin(const Followed& f, bool whole) {
   }
 }
 
-void LiveMap::commit(Followed f) {
+void LiveMap::commit(Followed f, bool map_changed) {
   for (const std::int64_t id : f.unencoded) chunks_[id] = nullptr;
   scan_bounds_ = std::move(f.bounds);
   scans_ = std::move(f.scans);
@@ -218,7 +256,7 @@ void LiveMap::commit(Followed f) {
       bounds_.extend(scan_bounds_[i].max);
     }
   }
-  ++generation_;
+  if (map_changed) ++generation_;
 }
 
 namespace {

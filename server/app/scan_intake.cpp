@@ -181,11 +181,20 @@ void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud, bool r
   // Brought back after a restart, the graph retraces the corrections already recorded: the
   // session gets one revision once all scans are back (resume_poses).
   if (!restoring) record_correction(added.corrected);
+  publish_plans(std::move(plans), scan.robot);
+  // The operator has candidates; the pose graph's pairwise matches follow, and where they
+  // change the map, the plans are made anew.
+  LiveMap::Refined refined = live_.refine();
+  if (!restoring) record_correction(refined.corrected);
+  publish_plans(std::move(refined.plans), scan.robot);
+}
+
+void ScanIntake::publish_plans(std::vector<PlanRecord> plans, const std::string& first) {
   // One plan per robot that is not driving, by robot id; the scanning robot's first.
   std::sort(plans.begin(), plans.end(),
             [](const PlanRecord& p, const PlanRecord& q) { return p.robot < q.robot; });
   std::stable_partition(plans.begin(), plans.end(),
-                        [&](const PlanRecord& p) { return p.robot == scan.robot; });
+                        [&](const PlanRecord& p) { return p.robot == first; });
   for (const PlanRecord& plan : plans) {
     events_.publish("plan_done", plan_done_json(plan));
   }
@@ -356,9 +365,7 @@ void ScanIntake::rebuild_map() {
                                   {"low_resolution_m2", a.low_resolution_m2},
                                   {"unscanned_m2", a.unscanned_m2},
                                   {"movable_m2", a.movable_m2}});
-  std::sort(plans.begin(), plans.end(),
-            [](const PlanRecord& p, const PlanRecord& q) { return p.robot < q.robot; });
-  for (const PlanRecord& plan : plans) events_.publish("plan_done", plan_done_json(plan));
+  publish_plans(std::move(plans), {});
 }
 
 std::vector<ScanIntake::NotInMap> ScanIntake::not_in_map() const {

@@ -111,6 +111,8 @@ class ScanIntake {
   // Brings one stored scan into the live map and tells the browsers; what the pose graph
   // changed is recorded and published unless `restoring` (a restart retracing the session).
   void process(const StoredScan& scan, const PointCloud& cloud, bool restoring = false);
+  // plan_done for each plan, by robot id, `first`'s first.
+  void publish_plans(std::vector<PlanRecord> plans, const std::string& first);
   // A correction of the map: a revision of the poses in the session and `map_corrected`.
   void record_correction(const MapCorrected& corrected);
   // After a restart: records the poses where they differ from the session's latest revision.
