@@ -114,7 +114,7 @@ LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
   // Writers take turns on encode_mutex_; readers only wait for the short commit below, and
   // they see the scan, its points, its chunk and the plan that includes it appear together.
   std::lock_guard encode_lock(encode_mutex_);
-  mission_.join(cloud, placement_of(scan), shared);
+  mission_.add(cloud, placement_of(scan), shared);
   // Only writers change the scans, under encode_mutex_ (held): read without mutex_.
   std::vector<StoredScan> scans = scans_;
   std::vector<std::shared_ptr<const PointCloud>> placed = placed_;
@@ -122,8 +122,7 @@ LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
   scans.push_back(scan);
   placed.push_back(shared);
   in_map.push_back(0);
-  Followed f = follow_mission(std::move(scans), std::move(placed), std::move(in_map),
-                              /*with_new_scan=*/true);
+  Followed f = follow_mission(std::move(scans), std::move(placed), std::move(in_map));
   rethin(f, /*whole=*/!f.corrected.empty());
   follow_robots(f);
   last_scan_ = {scan.id, scan.robot};
@@ -138,29 +137,6 @@ LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
   encode_wanted_.notify_one();
   // Outside mutex_ so readers are not held up, inside encode_mutex_ so maps and plans go out in
   // the order they were made; the map first, as the plan is made from it.
-  if (on_map) on_map(thinned_.cloud());
-  if (on_plan) {
-    for (const PlanRecord& plan : out.plans) on_plan(plan);
-  }
-  return out;
-}
-
-LiveMap::Refined LiveMap::refine() {
-  std::lock_guard encode_lock(encode_mutex_);
-  if (!mission_.refine()) return {};
-  Followed f = follow_mission(scans_, placed_, in_map_, /*with_new_scan=*/false);
-  Refined out;
-  out.corrected = f.corrected;
-  if (f.corrected.empty()) {
-    // Nothing an operator or the planner could see moved; the poses are kept all the same.
-    std::lock_guard lock(mutex_);
-    commit(std::move(f), /*map_changed=*/false);
-    return out;
-  }
-  rethin(f, /*whole=*/true);
-  follow_robots(f);
-  out.plans = refresh_derived([&] { commit(std::move(f)); });
-  encode_wanted_.notify_one();
   if (on_map) on_map(thinned_.cloud());
   if (on_plan) {
     for (const PlanRecord& plan : out.plans) on_plan(plan);
@@ -183,11 +159,10 @@ void LiveMap::follow_robots(const Followed& f) {
 
 LiveMap::Followed LiveMap::follow_mission(std::vector<StoredScan> scans,
                                           std::vector<std::shared_ptr<const PointCloud>> placed,
-                                          std::vector<std::uint8_t> in_map,
-                                          bool with_new_scan) const {
+                                          std::vector<std::uint8_t> in_map) const {
   Followed f;
   const MissionConfig& config = mission_.config();
-  const std::size_t newest = with_new_scan ? scans.size() - 1 : scans.size();
+  const std::size_t newest = scans.size() - 1;
   for (std::size_t i = 0; i < scans.size(); ++i) {
     const Pose& now = mission_.poses()[i];
     const bool now_in = mission_.in_map(i);
@@ -240,7 +215,7 @@ void LiveMap::rethin(const Followed& f, bool whole) {
   }
 }
 
-void LiveMap::commit(Followed f, bool map_changed) {
+void LiveMap::commit(Followed f) {
   for (const std::int64_t id : f.unencoded) chunks_[id] = nullptr;
   scan_bounds_ = std::move(f.bounds);
   scans_ = std::move(f.scans);
@@ -256,7 +231,7 @@ void LiveMap::commit(Followed f, bool map_changed) {
       bounds_.extend(scan_bounds_[i].max);
     }
   }
-  if (map_changed) ++generation_;
+  ++generation_;
 }
 
 namespace {

@@ -101,8 +101,7 @@ class LiveMap {
   // A stored scan joins the map: `cloud` is in the scan's own frame, `scan.placed` puts it in
   // the map frame (where its match put it; scan.match's information weighs it in the pose
   // graph). Scans must come in id order. Returns the plans made after it (one per robot not
-  // driving to a goal; the scanning robot's last) and what the pose graph changed. The pose
-  // graph's pairwise matches come after, in refine().
+  // driving to a goal; the scanning robot's last) and what the pose graph changed.
   // With the graph, a scan no believed match ties in waits outside the map (waiting()): its
   // points are in no map encoding, thinned map or bounds until it joins.
   struct Added {
@@ -111,15 +110,6 @@ class LiveMap {
     bool in_map = true;  // the new scan joined the map (with the graph, it may wait outside)
   };
   Added add(const StoredScan& scan, const PointCloud& cloud);
-  // After add() has answered (its plans published): the new scan's pairwise matches and
-  // another try at the scans waiting outside the map (MissionPipeline::refine). When that
-  // changes the map, the plans are made anew (returned, and told to on_plan). Call from the
-  // thread that calls add().
-  struct Refined {
-    std::vector<PlanRecord> plans;  // empty when the map did not change
-    MapCorrected corrected;
-  };
-  Refined refine();
 
   // The map made anew from `keep` (stored scans, in id order, at their placed poses): after the
   // operator took a scan out or put one back. Points of scans the map holds are reused; the
@@ -234,19 +224,18 @@ class LiveMap {
     std::vector<std::int64_t> unencoded;  // ids whose chunk must be made anew
     MapCorrected corrected;
   };
-  // `with_new_scan`: the last of `scans` just joined (its moves are not corrections).
+  // The last of `scans` just joined (its moves are not corrections).
   Followed follow_mission(std::vector<StoredScan> scans,
                           std::vector<std::shared_ptr<const PointCloud>> placed,
-                          std::vector<std::uint8_t> in_map, bool with_new_scan) const;
+                          std::vector<std::uint8_t> in_map) const;
   // Where each robot is planned from, as `f` has the scans. Needs encode_mutex_ held.
   void follow_robots(const Followed& f);
   // The thinned map of the scans in `f` that are in the map: made anew when `whole` (it cannot
   // take a scan out), else the newest added. Needs encode_mutex_ held.
   void rethin(const Followed& f, bool whole);
   // Publishes `f`: scans, points, in-map flags, bounds and counts; the chunks of moved scans
-  // are dropped to be made anew; the whole map is encoded again when `map_changed` (not when
-  // only scans outside the map moved). Needs mutex_ and encode_mutex_ held.
-  void commit(Followed f, bool map_changed = true);
+  // are dropped to be made anew. Needs mutex_ and encode_mutex_ held.
+  void commit(Followed f);
   std::vector<Bounds3> scan_bounds_;  // per scan, of placed_
   // Where scan `id` is in scans_. Needs mutex_ (or encode_mutex_) held.
   std::optional<std::size_t> index_of(std::int64_t id) const;

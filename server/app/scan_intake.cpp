@@ -182,11 +182,6 @@ void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud, bool r
   // session gets one revision once all scans are back (resume_poses).
   if (!restoring) record_correction(added.corrected);
   publish_plans(std::move(plans), scan.robot);
-  // The operator has candidates; the pose graph's pairwise matches follow, and where they
-  // change the map, the plans are made anew.
-  LiveMap::Refined refined = live_.refine();
-  if (!restoring) record_correction(refined.corrected);
-  publish_plans(std::move(refined.plans), scan.robot);
 }
 
 void ScanIntake::publish_plans(std::vector<PlanRecord> plans, const std::string& first) {

@@ -114,12 +114,6 @@ std::shared_ptr<const PointCloud> MissionPipeline::add(const PointCloud& scan,
 
 void MissionPipeline::add(const PointCloud& scan, const Placement& where,
                           std::shared_ptr<const PointCloud> in_map) {
-  join(scan, where, std::move(in_map));
-  refine();
-}
-
-void MissionPipeline::join(const PointCloud& scan, const Placement& where,
-                           std::shared_ptr<const PointCloud> in_map) {
   const bool anchored = placed_.empty() || where.matched;
   anchored_.push_back(anchored ? 1 : 0);
   placed_.push_back(std::move(in_map));
@@ -132,26 +126,17 @@ void MissionPipeline::join(const PointCloud& scan, const Placement& where,
     join_map(scan, placed_.size() - 1);
     return;
   }
-  before_ = poses_;
+  const std::vector<Pose> before = poses_;
   const std::optional<SensorFix> fix = where.matched ? std::nullopt : sensors_place(where);
-  GraphUpdate update = graph_->join(scan, where, where.matched && unsure(where));
+  GraphUpdate update = graph_->add(scan, where, where.matched && unsure(where));
   const std::size_t k = placed_.size() - 1;
   if (fix && !graph_->anchored(k)) {
     graph_->anchor_by_sensors(k, fix->from, fix->information);
     update.solve = graph_->solve();
   }
   follow_graph();
-  joined_ = update;
-  last_correction_ = correction(update, before_);
-}
-
-bool MissionPipeline::refine() {
-  if (!graph_ || placed_.empty()) return false;
-  GraphUpdate update = graph_->relate(placed_.size() - 1);
-  if (update.pairs_matched > 0) follow_graph();
   if (rematch_refused(update)) follow_graph();
-  last_correction_ = correction(merged(joined_, update), before_);
-  return true;
+  last_correction_ = correction(update, before);
 }
 
 void MissionPipeline::join_map(const PointCloud& own, std::size_t i) {

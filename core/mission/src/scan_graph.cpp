@@ -105,36 +105,6 @@ std::optional<std::size_t> ScanGraph::last_of(const std::string& track) const {
 }
 
 GraphUpdate ScanGraph::add(const PointCloud& scan, const Placement& where, bool tentative) {
-  GraphUpdate joined = join(scan, where, tentative);
-  GraphUpdate related = relate(size() - 1);
-  return merged(joined, related);
-}
-
-GraphUpdate merged(const GraphUpdate& first, const GraphUpdate& then) {
-  GraphUpdate out = then;
-  out.pairs_tried += first.pairs_tried;
-  out.pairs_matched += first.pairs_matched;
-  out.match_ms += first.match_ms;
-  out.rematches_tried += first.rematches_tried;
-  out.rematched += first.rematched;
-  // The latest solve is where the graph stands (`then` solved only when a match came of it);
-  // its time is both solves'.
-  if (then.pairs_matched == 0 && then.rematched == 0) {
-    out.solve = first.solve;
-  } else {
-    out.solve.time_ms += first.solve.time_ms;
-  }
-  return out;
-}
-
-GraphUpdate ScanGraph::relate(std::size_t k) {
-  GraphUpdate update;
-  match_pairs(k, map_matched_.at(k) != 0, update);
-  if (update.pairs_matched > 0) update.solve = solve();
-  return update;
-}
-
-GraphUpdate ScanGraph::join(const PointCloud& scan, const Placement& where, bool tentative) {
   const MoveUncertainty uncertain =
       where.matched && !tentative
           ? MoveUncertainty{}
@@ -147,7 +117,6 @@ GraphUpdate ScanGraph::join(const PointCloud& scan, const Placement& where, bool
   tracks_.push_back(where.track);
   const bool matched = where.matched && !tentative;
   anchored_.push_back(k == 0 || matched ? 1 : 0);
-  map_matched_.push_back(matched ? 1 : 0);
   uncertain_.push_back(uncertain);
   pending_.emplace_back();
   pending_map_.emplace_back();
@@ -157,6 +126,7 @@ GraphUpdate ScanGraph::join(const PointCloud& scan, const Placement& where, bool
   last_of_track_[where.track] = k;
 
   GraphUpdate update;
+  match_pairs(k, matched, update);
   if (matched) {
     add_match_to_map(k, where.placed, where.information, "map");
     confirm_by_odometry(k);  // the robot's scan before may be waiting for this one

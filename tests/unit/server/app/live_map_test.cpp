@@ -35,13 +35,8 @@ class LiveMapGraphTest : public ::testing::Test {
     c.planner.policy = PlannerPolicy::kExhaustive;
     return c;
   }
-  // Scan `id` taken at `truth`, reported at `reported`, matched as the server matches it: the
-  // scan joins (add), then its pairs are matched (refine).
-  struct Joined {
-    LiveMap::Added added;
-    LiveMap::Refined refined;
-  };
-  Joined add(std::int64_t id, const Pose& truth, const Pose& reported, bool match = true) {
+  // Scan `id` taken at `truth`, reported at `reported`, matched as the server matches it.
+  LiveMap::Added add(std::int64_t id, const Pose& truth, const Pose& reported, bool match = true) {
     StoredScan s;
     s.id = id;
     s.robot = "robot1";
@@ -56,9 +51,7 @@ class LiveMapGraphTest : public ::testing::Test {
         s.placed = m->placed;
       }
     }
-    Joined out{map_.add(s, cloud), {}};
-    out.refined = map_.refine();
-    return out;
+    return map_.add(s, cloud);
   }
   static World* world_;
   static RayCaster* caster_;
@@ -78,7 +71,7 @@ TEST_F(LiveMapGraphTest, AScanTiedInLaterJoinsTheMapWhereItBelongs) {
   add(1, at(-15, -8, 0), at(-15, -8, 0));
   const std::size_t points_one = map_.point_count();
   // Unmatched (as a refused match leaves it), 2 m off: it waits outside the map.
-  const LiveMap::Added second = add(2, at(-5, -9, 0), at(-3, -7, 0), /*match=*/false).added;
+  const LiveMap::Added second = add(2, at(-5, -9, 0), at(-3, -7, 0), /*match=*/false);
   EXPECT_FALSE(second.in_map);
   EXPECT_EQ(map_.waiting(), std::vector<std::int64_t>{2});
   EXPECT_EQ(map_.point_count(), points_one) << "a waiting scan's points are not in the map";
@@ -86,15 +79,13 @@ TEST_F(LiveMapGraphTest, AScanTiedInLaterJoinsTheMapWhereItBelongs) {
   ASSERT_EQ(second.corrected.poses.size(), 1u) << "its pose is recorded as waiting";
   EXPECT_FALSE(second.corrected.poses[0].in_map);
 
-  // A third scan, placed by its match, joins at once; its pairwise match agrees with the first
-  // on where the second lies, and that ties the second in.
-  const Joined joined = add(3, at(-12, 4, 30), at(-12, 4, 30));
-  EXPECT_TRUE(joined.added.in_map);
-  EXPECT_TRUE(joined.added.corrected.joined.empty()) << "not before its pairs are matched";
+  // A third scan, placed by its match: its pairwise match agrees with the first on where the
+  // second lies, and that ties the second in.
+  const LiveMap::Added third = add(3, at(-12, 4, 30), at(-12, 4, 30));
+  EXPECT_TRUE(third.in_map);
   EXPECT_TRUE(map_.waiting().empty());
-  const LiveMap::Refined& third = joined.refined;
   EXPECT_EQ(third.corrected.joined, std::vector<std::int64_t>{2});
-  EXPECT_FALSE(third.plans.empty()) << "planned anew on the corrected map";
+  EXPECT_FALSE(third.plans.empty()) << "planned on the corrected map";
   const auto scans = map_.scans();
   ASSERT_EQ(scans.size(), 3u);
   EXPECT_NEAR(scans[1].placed.x, -5, 0.03);

@@ -90,14 +90,6 @@ class MissionPipeline {
   // The same with the points in the map frame already made (to_map_frame).
   void add(const PointCloud& scan, const Placement& where,
            std::shared_ptr<const PointCloud> in_map);
-  // add() in two steps, for an owner that plans on the scan before the slower pairwise matches
-  // (the server): the scan joins the graph with its odometry and map match and the map
-  // follows (milliseconds); then refine() matches its pairs and tries the refused scans
-  // again, and the map follows once more (last_correction() then covers both). refine() is
-  // false, and does nothing, without the graph.
-  void join(const PointCloud& scan, const Placement& where,
-            std::shared_ptr<const PointCloud> in_map);
-  bool refine();
   static std::shared_ptr<const PointCloud> to_map_frame(const PointCloud& scan, const Pose& placed);
 
   // Planned: the next scan point for each robot (plan_fleet, PlanInput::claimed for `claimed`,
@@ -155,8 +147,6 @@ class MissionPipeline {
   std::vector<std::uint8_t> in_map_;
   std::optional<ScanGraph> graph_;
   std::optional<MapCorrection> last_correction_;
-  std::vector<Pose> before_;  // the poses before the latest scan joined
-  GraphUpdate joined_;        // what join() did for the latest scan
   // Per scan: how many anchored scans lay near it when it was last matched to the map; it is
   // tried again when more do.
   std::vector<std::size_t> anchored_near_;

@@ -84,9 +84,6 @@ struct GraphUpdate {
   GraphSolveReport solve;
 };
 
-// `first` then `then`, as one update (the counts summed, the latest solve).
-GraphUpdate merged(const GraphUpdate& first, const GraphUpdate& then);
-
 // The scans of a mission as a pose graph (issue 17): the robot's odometry between its
 // consecutive scans, each believed scan-to-map match, and pairwise matches between every two
 // scans near each other (so a scan that could not be matched when it came is tied in by later
@@ -96,18 +93,11 @@ class ScanGraph {
  public:
   ScanGraph(ScanGraphConfig config, PoseNoise noise);
 
-  // Scan `scan` (own frame) joins at `where`; its pairs are matched and the graph optimised:
-  // join() then relate().
+  // Scan `scan` (own frame) joins at `where`; its pairs are matched and the graph optimised.
   // `tentative`: where.matched, but the match corrected the pose further than the sensors
   // usually err; it ties the scan in once the odometry to the robot's next or previous scan
   // agrees (confirm_by_odometry).
   GraphUpdate add(const PointCloud& scan, const Placement& where, bool tentative = false);
-  // add() in two steps, for an owner that answers with the scan joined before the slower
-  // pairwise matches (the server plans after join()): the node, its odometry and its map
-  // match, optimised (about a millisecond); then the pairs of scan `k` (tens to hundreds of
-  // milliseconds each), optimised again when any matched.
-  GraphUpdate join(const PointCloud& scan, const Placement& where, bool tentative = false);
-  GraphUpdate relate(std::size_t k);
   // A scan not anchored so far was matched to the map after all (MapMatch::placed and
   // ::information): it is tied to the anchored scan nearest to where the match put it. Call
   // solve() after.
@@ -178,7 +168,6 @@ class ScanGraph {
   std::vector<std::shared_ptr<const PointCloud>> thinned_;  // levelled, per scan
   std::vector<Pose> reported_;
   std::vector<std::uint8_t> anchored_;
-  std::vector<std::uint8_t> map_matched_;   // per scan: its own map match was believed at once
   std::vector<MoveUncertainty> uncertain_;  // per scan: of its estimate while not anchored
   std::map<std::string, std::size_t> last_of_track_;
   std::vector<std::string> origins_;  // per edge
