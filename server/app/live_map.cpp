@@ -1,5 +1,7 @@
 #include "app/live_map.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -269,6 +271,14 @@ std::vector<PlanRecord> LiveMap::make_plans() const {
   std::vector<PlanRecord> records;
   for (FleetPlan& decided : mission_.plan(robots, std::move(claims))) {
     const Plan& plan = decided.plan;
+    if (plan.ranked.empty()) {
+      const Pose& at = scan_pose_of_.at(decided.robot);
+      spdlog::warn(
+          "no candidate for '{}' from ({:.1f}, {:.1f}): movable region {:.0f} m², {:.0f} m² "
+          "unscanned and {:.0f} m² low-resolution in the target region",
+          decided.robot, at.x, at.y, plan.movable.area_m2(), plan.regions.unscanned_m2(),
+          plan.regions.low_resolution_m2());
+    }
     PlanRecord record;
     record.id = plans_.new_plan_id();
     record.based_on_scan = last_scan_.first;

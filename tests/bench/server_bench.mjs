@@ -8,7 +8,7 @@
 // for the whole map's new encoding (GET map.drc), as a robot's one-minute scan would. Prints one JSON line. Run with
 // tests/bench/server_bench.sh.
 import { execFileSync } from 'node:child_process';
-import { readFileSync, mkdtempSync, mkdirSync, rmSync } from 'node:fs';
+import { readFileSync, mkdtempSync, mkdirSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { createRequire } from 'node:module';
@@ -100,6 +100,8 @@ try {
 } finally {
   ws.close();
   await stack.stop();
+  // The server's own account (matches, corrections, plans without a candidate), when asked for.
+  if (process.env.SCANPLAN_BENCH_SERVER_LOG) writeFileSync(process.env.SCANPLAN_BENCH_SERVER_LOG, stack.server.log);
   rmSync(work, { recursive: true, force: true });
 }
 

@@ -424,16 +424,12 @@ function onEvent(e) {
       log.add({ ...e, kind: e.type });
       break;
     case 'map_corrected':
-      log.add({ ...e, kind: 'map_corrected' });
-      chunks.forget([...(e.scans || []), ...(e.joined || [])]);
-      soon(() => {
-        refreshSession();
-        refreshScans();
-        refreshLayer();
-        refreshCandidates();
-      });
-      break;
     case 'map_rebuilt':
+      if (e.type === 'map_corrected') {
+        log.add({ ...e, kind: 'map_corrected' });
+        // Fetched again where they now are (refreshScans syncs the chunks).
+        chunks.forget([...(e.scans || []), ...(e.joined || [])]);
+      }
       soon(() => {
         refreshSession();
         refreshScans();
