@@ -163,21 +163,27 @@ nlohmann::json accuracy_of(const LoopResult& r) {
     if (v.empty()) return nullptr;
     return *std::max_element(v.begin(), v.end());
   };
-  return {{"matches_tried", tried},
-          {"matches_applied", applied},
-          {"placed_error_median_m", median(metres)},
-          {"placed_error_median_deg", median(degrees)},
-          {"placed_error_max_m", worst(metres)},
-          {"placed_error_max_deg", worst(degrees)},
-          {"matched_error_median_m", median(matched_m)},
-          {"matched_error_median_deg", median(matched_deg)},
-          {"matched_error_max_m", worst(matched_m)},
-          {"matched_error_max_deg", worst(matched_deg)},
-          {"scans_in_map", in_map_m.size() + 1},
-          {"in_map_error_median_m", median(in_map_m)},
-          {"in_map_error_max_m", worst(in_map_m)},
-          {"solve_ms_median", median(solve_ms)},
-          {"solve_ms_max", worst(solve_ms)}};
+  return {
+      {"matches_tried", tried},
+      {"matches_applied", applied},
+      {"placed_error_median_m", median(metres)},
+      {"placed_error_median_deg", median(degrees)},
+      {"placed_error_max_m", worst(metres)},
+      {"placed_error_max_deg", worst(degrees)},
+      {"matched_error_median_m", median(matched_m)},
+      {"matched_error_median_deg", median(matched_deg)},
+      {"matched_error_max_m", worst(matched_m)},
+      {"matched_error_max_deg", worst(matched_deg)},
+      {"scans_in_map", in_map_m.size() + 1},
+      {"in_map_error_median_m", median(in_map_m)},
+      {"in_map_error_max_m", worst(in_map_m)},
+      {"solve_ms_median", median(solve_ms)},
+      {"solve_ms_max", worst(solve_ms)},
+      // How far apart overlapping scans' surfaces are in the final map (SurfaceDistance).
+      {"surface_pairs", r.surface.pairs},
+      {"surface_distance_median_m", r.surface.pairs ? nlohmann::json(r.surface.median_m) : nullptr},
+      {"surface_distance_worst_pair_m",
+       r.surface.pairs ? nlohmann::json(r.surface.worst_pair_m) : nullptr}};
 }
 
 // The pose graph's edges against the truth: which kinds of relation go wrong, and whether the

@@ -4,6 +4,8 @@
 #include <random>
 #include <set>
 
+#include "scanplan/geometry/voxel_filter.hpp"
+#include "scanplan/registration/alignment_quality.hpp"
 #include "scanplan/sim/simulated_odometry.hpp"
 #include "scanplan/sim/simulated_scanner.hpp"
 #include "scanplan/sim/world_traversability.hpp"
@@ -119,6 +121,50 @@ void step_errors(const LoopStep& first, LoopStep& step) {
     step.match_error_deg = d;
   }
 }
+
+}  // namespace
+
+SurfaceDistance surface_distance(const MissionPipeline& mission, double max_apart_m) {
+  // Thinned for speed: the target's surface from 0.1 m cubes (its normals from eight of them),
+  // 0.2 m cubes of the other scan measured against it.
+  constexpr double kTargetVoxelM = 0.1, kSourceVoxelM = 0.2;
+  // Points farther than this from the other scan see what it did not: no overlap there.
+  constexpr double kOverlapM = 0.2;
+  constexpr std::size_t kMinOverlapPoints = 500;
+  std::vector<std::size_t> in_map;
+  for (std::size_t i = 0; i < mission.poses().size(); ++i) {
+    if (mission.in_map(i)) in_map.push_back(i);
+  }
+  std::vector<PointCloud> target(mission.poses().size()), source(mission.poses().size());
+  for (const std::size_t i : in_map) {
+    target[i] = voxel_downsample(*mission.placed_scans()[i], kTargetVoxelM);
+    source[i] = voxel_downsample(*mission.placed_scans()[i], kSourceVoxelM);
+  }
+  SurfaceDistance out;
+  std::vector<double> medians;
+  for (std::size_t a = 0; a < in_map.size(); ++a) {
+    const Pose& pa = mission.poses()[in_map[a]];
+    const AlignmentJudge judge(target[in_map[a]]);
+    for (std::size_t b = a + 1; b < in_map.size(); ++b) {
+      const Pose& pb = mission.poses()[in_map[b]];
+      if (std::hypot(pa.x - pb.x, pa.y - pb.y) > max_apart_m) continue;
+      const AlignmentQuality q = judge.evaluate(source[in_map[b]], Eigen::Isometry3d::Identity(),
+                                                Dof::k4, kOverlapM, kOverlapM);
+      if (q.inliers < kMinOverlapPoints) continue;
+      medians.push_back(q.median_plane_distance_m);
+      out.worst_pair_m = std::max(out.worst_pair_m, q.median_plane_distance_m);
+    }
+  }
+  out.pairs = medians.size();
+  if (!medians.empty()) {
+    const auto middle = medians.begin() + static_cast<std::ptrdiff_t>(medians.size() / 2);
+    std::nth_element(medians.begin(), middle, medians.end());
+    out.median_m = *middle;
+  }
+  return out;
+}
+
+namespace {
 
 // Where the graph had each scan when the mission ended, against the truth.
 void final_errors(const MissionPipeline& mission, LoopResult& result) {
@@ -240,6 +286,7 @@ LoopResult run_closed_loop(
     if (last) result.stopped_because = "scan limit reached";
   }
   final_errors(mission, result);
+  result.surface = surface_distance(mission);
   return result;
 }
 

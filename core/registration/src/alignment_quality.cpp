@@ -54,6 +54,7 @@ AlignmentQuality AlignmentJudge::evaluate(const PointCloud& source,
   const float normal_sq = static_cast<float>(16 * inlier_sq);
   double inlier_sum = 0;
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> planar;  // point, normal
+  std::vector<double> plane_distance;
   for (const auto& p : source.points) {
     const Eigen::Vector3f moved = T * p;
     std::uint32_t index[1];
@@ -67,12 +68,18 @@ AlignmentQuality AlignmentJudge::evaluate(const PointCloud& source,
       Eigen::Vector3d n;
       if (with_constraint && surface_normal(tree, moved, normal_sq, n)) {
         planar.emplace_back(moved.cast<double>(), n);
+        const Eigen::Vector3d m = target_.points[index[0]].cast<double>();
+        plane_distance.push_back(std::abs(n.dot(moved.cast<double>() - m)));
       }
     }
   }
   q.inlier_ratio = static_cast<double>(q.inliers) / static_cast<double>(q.points);
   q.rmse = q.inliers ? std::sqrt(inlier_sum / static_cast<double>(q.inliers)) : 0.0;
   if (planar.empty()) return q;
+  const auto middle =
+      plane_distance.begin() + static_cast<std::ptrdiff_t>(plane_distance.size() / 2);
+  std::nth_element(plane_distance.begin(), middle, plane_distance.end());
+  q.median_plane_distance_m = *middle;
 
   double radius_sq = 0;
   for (const auto& [p, n] : planar) radius_sq += p.squaredNorm();

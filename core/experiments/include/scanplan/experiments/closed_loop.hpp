@@ -89,9 +89,21 @@ struct LoopEdge {
   double whitened = 0;                // PoseGraph::whitened_error at the end
 };
 
+// How far apart the surfaces of overlapping scans in the map are (issue 17's target: median
+// ≤ 2 cm, the range noise being 1 cm): for every two scans in the map within `max_apart_m` of
+// each other that share at least 500 points within 0.2 m, the median distance of one scan's
+// points from the other's surface along its normal; `median_m` is the median over those pairs,
+// `worst_pair_m` the largest.
+struct SurfaceDistance {
+  std::size_t pairs = 0;
+  double median_m = 0, worst_pair_m = 0;
+};
+SurfaceDistance surface_distance(const MissionPipeline& mission, double max_apart_m = 45.0);
+
 struct LoopResult {
   std::vector<LoopStep> steps;
   std::vector<LoopEdge> edges;      // empty with the graph off
+  SurfaceDistance surface;          // the map at the end
   std::size_t reachable_cells = 0;  // the coverage denominator
   std::optional<int> scans_to_95pct;
   std::optional<double> path_to_95pct_m;

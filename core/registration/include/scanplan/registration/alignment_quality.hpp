@@ -34,6 +34,10 @@ struct AlignmentQuality {
   // measurements, and counting each would make every match look millimetre-sure. Zero unless
   // with_constraint.
   Eigen::Matrix4d information = Eigen::Matrix4d::Zero();
+  // The median distance of the inliers from the target's surface along its normal (those where
+  // the target forms a surface): how far apart the two scans' surfaces are, which the range
+  // noise and the alignment make, without the sampling's spacing. Zero unless with_constraint.
+  double median_plane_distance_m = 0;
 };
 
 namespace detail {
