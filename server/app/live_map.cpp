@@ -125,7 +125,11 @@ LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
   placed.push_back(shared);
   in_map.push_back(0);
   Followed f = follow_mission(std::move(scans), std::move(placed), std::move(in_map));
-  rethin(f, /*whole=*/!f.corrected.empty());
+  // The thinned map is 0.3 m cubes: made anew when scans join or leave the map or move by a
+  // third of a cube (a few seconds' work on a large map), else the new scan is added.
+  const MapCorrected& c = f.corrected;
+  rethin(f,
+         /*whole=*/!c.joined.empty() || !c.left.empty() || c.max_moved_m > kThinnedMapVoxelM / 3);
   follow_robots(f);
   last_scan_ = {scan.id, scan.robot};
   Added out;

@@ -183,7 +183,12 @@ nlohmann::json accuracy_of(const LoopResult& r) {
       {"surface_pairs", r.surface.pairs},
       {"surface_distance_median_m", r.surface.pairs ? nlohmann::json(r.surface.median_m) : nullptr},
       {"surface_distance_worst_pair_m",
-       r.surface.pairs ? nlohmann::json(r.surface.worst_pair_m) : nullptr}};
+       r.surface.pairs ? nlohmann::json(r.surface.worst_pair_m) : nullptr},
+      {"wall_pairs", r.surface.wall_pairs},
+      {"wall_distance_median_m",
+       r.surface.wall_pairs ? nlohmann::json(r.surface.wall_median_m) : nullptr},
+      {"wall_distance_worst_pair_m",
+       r.surface.wall_pairs ? nlohmann::json(r.surface.worst_wall_pair_m) : nullptr}};
 }
 
 // The pose graph's edges against the truth: which kinds of relation go wrong, and whether the

@@ -140,8 +140,9 @@ SurfaceDistance surface_distance(const MissionPipeline& mission, double max_apar
     target[i] = voxel_downsample(*mission.placed_scans()[i], kTargetVoxelM);
     source[i] = voxel_downsample(*mission.placed_scans()[i], kSourceVoxelM);
   }
+  constexpr std::size_t kMinWallPoints = 100;
   SurfaceDistance out;
-  std::vector<double> medians;
+  std::vector<double> medians, wall_medians;
   for (std::size_t a = 0; a < in_map.size(); ++a) {
     const Pose& pa = mission.poses()[in_map[a]];
     const AlignmentJudge judge(target[in_map[a]]);
@@ -153,14 +154,20 @@ SurfaceDistance surface_distance(const MissionPipeline& mission, double max_apar
       if (q.inliers < kMinOverlapPoints) continue;
       medians.push_back(q.median_plane_distance_m);
       out.worst_pair_m = std::max(out.worst_pair_m, q.median_plane_distance_m);
+      if (q.wall_inliers < kMinWallPoints) continue;
+      wall_medians.push_back(q.median_wall_distance_m);
+      out.worst_wall_pair_m = std::max(out.worst_wall_pair_m, q.median_wall_distance_m);
     }
   }
+  const auto median = [](std::vector<double>& v) {
+    const auto middle = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+    std::nth_element(v.begin(), middle, v.end());
+    return *middle;
+  };
   out.pairs = medians.size();
-  if (!medians.empty()) {
-    const auto middle = medians.begin() + static_cast<std::ptrdiff_t>(medians.size() / 2);
-    std::nth_element(medians.begin(), middle, medians.end());
-    out.median_m = *middle;
-  }
+  if (!medians.empty()) out.median_m = median(medians);
+  out.wall_pairs = wall_medians.size();
+  if (!wall_medians.empty()) out.wall_median_m = median(wall_medians);
   return out;
 }
 

@@ -24,6 +24,12 @@ bool surface_normal(const detail::PointKdTree& tree, const Eigen::Vector3f& q, f
   return true;
 }
 
+double median_of(std::vector<double>& v) {
+  const auto middle = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), middle, v.end());
+  return *middle;
+}
+
 }  // namespace
 
 AlignmentJudge::AlignmentJudge(const PointCloud& target)
@@ -54,7 +60,7 @@ AlignmentQuality AlignmentJudge::evaluate(const PointCloud& source,
   const float normal_sq = static_cast<float>(16 * inlier_sq);
   double inlier_sum = 0;
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> planar;  // point, normal
-  std::vector<double> plane_distance;
+  std::vector<double> plane_distance, wall_distance;
   for (const auto& p : source.points) {
     const Eigen::Vector3f moved = T * p;
     std::uint32_t index[1];
@@ -70,16 +76,16 @@ AlignmentQuality AlignmentJudge::evaluate(const PointCloud& source,
         planar.emplace_back(moved.cast<double>(), n);
         const Eigen::Vector3d m = target_.points[index[0]].cast<double>();
         plane_distance.push_back(std::abs(n.dot(moved.cast<double>() - m)));
+        if (std::abs(n.z()) < std::sqrt(0.5)) wall_distance.push_back(plane_distance.back());
       }
     }
   }
   q.inlier_ratio = static_cast<double>(q.inliers) / static_cast<double>(q.points);
   q.rmse = q.inliers ? std::sqrt(inlier_sum / static_cast<double>(q.inliers)) : 0.0;
   if (planar.empty()) return q;
-  const auto middle =
-      plane_distance.begin() + static_cast<std::ptrdiff_t>(plane_distance.size() / 2);
-  std::nth_element(plane_distance.begin(), middle, plane_distance.end());
-  q.median_plane_distance_m = *middle;
+  q.median_plane_distance_m = median_of(plane_distance);
+  q.wall_inliers = wall_distance.size();
+  if (!wall_distance.empty()) q.median_wall_distance_m = median_of(wall_distance);
 
   double radius_sq = 0;
   for (const auto& [p, n] : planar) radius_sq += p.squaredNorm();

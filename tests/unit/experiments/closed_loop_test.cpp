@@ -145,7 +145,7 @@ TEST(SurfaceDistance, OverlappingScansAtTheirPosesShareTheirSurfaces) {
     p.z = w.ground_height(x, y);
     return p;
   };
-  const auto mission_with_second_at = [&](double dz) {
+  const auto mission_with_second_at = [&](double dz, double dx = 0) {
     MissionConfig config;
     config.mapping.sensor_height_m = w.scanner.mount_height_m;
     config.graph.reset();  // each scan stays where it is put
@@ -154,6 +154,7 @@ TEST(SurfaceDistance, OverlappingScansAtTheirPosesShareTheirSurfaces) {
     mission.add(simulate_scan(caster, w.scanner, first, 1), {first, first, true});
     Pose off = second;
     off.z += dz;
+    off.x += dx;
     mission.add(simulate_scan(caster, w.scanner, second, 2), {second, off, true});
     return surface_distance(mission);
   };
@@ -166,6 +167,17 @@ TEST(SurfaceDistance, OverlappingScansAtTheirPosesShareTheirSurfaces) {
   ASSERT_EQ(high.pairs, 1u);
   EXPECT_GT(high.median_m, 0.012);
   EXPECT_GT(high.median_m, 2 * right.median_m);
+  // A scan 10 cm off sideways: the floor hides it (all surfaces 6 mm), the walls facing that
+  // way show it (1.8 cm against 8 mm; those facing across do not).
+  EXPECT_GT(right.wall_pairs, 0u);
+  EXPECT_LT(right.wall_median_m, 0.01);
+  const SurfaceDistance aside = mission_with_second_at(0, 0.10);
+  ASSERT_EQ(aside.wall_pairs, 1u);
+  EXPECT_GT(aside.wall_median_m, 0.015);
+  EXPECT_GT(aside.wall_median_m, 2 * right.wall_median_m);
+  RecordProperty("wall_median_right_m", std::to_string(right.wall_median_m));
+  RecordProperty("wall_median_10cm_aside_m", std::to_string(aside.wall_median_m));
+  RecordProperty("median_10cm_aside_m", std::to_string(aside.median_m));
   RecordProperty("median_right_m", std::to_string(right.median_m));
   RecordProperty("median_5cm_high_m", std::to_string(high.median_m));
 }

@@ -93,10 +93,13 @@ struct LoopEdge {
 // ≤ 2 cm, the range noise being 1 cm): for every two scans in the map within `max_apart_m` of
 // each other that share at least 500 points within 0.2 m, the median distance of one scan's
 // points from the other's surface along its normal; `median_m` is the median over those pairs,
-// `worst_pair_m` the largest.
+// `worst_pair_m` the largest. The same over the walls alone (`wall_*`, pairs sharing at least
+// 100 wall points): on flat open ground two scans metres apart in x-y still share the floor.
 struct SurfaceDistance {
   std::size_t pairs = 0;
   double median_m = 0, worst_pair_m = 0;
+  std::size_t wall_pairs = 0;
+  double wall_median_m = 0, worst_wall_pair_m = 0;
 };
 SurfaceDistance surface_distance(const MissionPipeline& mission, double max_apart_m = 45.0);
 

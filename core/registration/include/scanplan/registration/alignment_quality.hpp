@@ -38,6 +38,10 @@ struct AlignmentQuality {
   // the target forms a surface): how far apart the two scans' surfaces are, which the range
   // noise and the alignment make, without the sampling's spacing. Zero unless with_constraint.
   double median_plane_distance_m = 0;
+  // The same over the inliers on walls (the target's normal within 45° of level) alone, and how
+  // many there are: on open ground a horizontal error hides under the floor's distance of zero.
+  double median_wall_distance_m = 0;
+  std::size_t wall_inliers = 0;
 };
 
 namespace detail {
