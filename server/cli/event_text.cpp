@@ -112,7 +112,7 @@ std::string map_corrected(const json& e) {
   }
   if (count_of(e, "joined") > 0) parts.push_back(scans("joined") + " tied into the map");
   if (count_of(e, "left") > 0) {
-    parts.push_back(scans("left") + " set outside the map (its match no longer agrees)");
+    parts.push_back(scans("left") + " set outside the map until a match agrees again");
   }
   std::string text = "map corrected:";
   for (std::size_t i = 0; i < parts.size(); ++i) text += (i ? "; " : " ") + parts[i];

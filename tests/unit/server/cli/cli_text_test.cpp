@@ -228,6 +228,17 @@ TEST(EventText, DescribesEachEventType) {
   EXPECT_EQ(d(R"({"type":"annotation_deleted","id":3,"by":"operator"})"), "#3 deleted by operator");
   EXPECT_EQ(d(R"({"type":"binary_dropped","count":2,"first_id":3,"last_id":4})"),
             "2 map chunks (scans 3..4) dropped: this link is too slow for them");
+  EXPECT_EQ(d(R"({"type":"map_corrected","scans":[3,4,5,6,7,8,9,12],"joined":[14],"left":[],
+                 "max_moved_m":0.118,"max_turned_deg":0.12,"revision":7})"),
+            "map corrected: scans 3\u20139, 12 moved up to 12 cm / 0.1 deg; scan 14 tied into the "
+            "map (pose revision 7)");
+  EXPECT_EQ(d(R"({"type":"map_corrected","scans":[],"joined":[],"left":[5,6],
+                 "max_moved_m":0,"max_turned_deg":0,"revision":0})"),
+            "map corrected: scans 5\u20136 set outside the map until a match agrees again");
+  EXPECT_EQ(d(R"({"type":"map_updated","scan":4,"points":10,"in_map":false,"completed_m2":1,
+                 "low_resolution_m2":2,"unscanned_m2":3,"movable_m2":4})"),
+            "scan 4 waits outside the map until a match ties it in: completed 1 m2, low-res 2 m2, "
+            "unscanned 3 m2, movable 4 m2");
   EXPECT_EQ(d(R"({"type":"something_new","at":"t","value":1})"), R"({"value":1})")
       << "an unknown event is shown, not hidden";
 }
