@@ -224,7 +224,8 @@ void ScanIntake::record_correction(const MapCorrected& corrected) {
 void ScanIntake::resume_poses() {
   // The graph rebuilt from the recorded matches should stand where the session's latest
   // revision left it; where it does not (a revision lost to a full disk, a solver that settled
-  // differently), what the map now shows is recorded as a revision of its own.
+  // differently, a scan taken out of the map or put back), what the map now shows is recorded
+  // as a revision of its own.
   std::map<std::int64_t, RevisedPose> recorded;
   for (const RevisedPose& r : session_.latest_poses()) recorded[r.scan] = r;
   const std::vector<std::int64_t> waiting = live_.waiting();
@@ -235,21 +236,25 @@ void ScanIntake::resume_poses() {
     const Pose was = it == recorded.end() ? session_.scan(s.id)->placed : it->second.pose;
     const bool was_in = it == recorded.end() || it->second.in_map;
     const double moved = std::hypot(s.placed.x - was.x, s.placed.y - was.y, s.placed.z - was.z);
-    if (moved > kResumeToleranceM || in_map != was_in) {
-      differ.poses.push_back({s.id, s.placed, in_map});
+    if (moved <= kResumeToleranceM && in_map == was_in) continue;
+    differ.poses.push_back({s.id, s.placed, in_map});
+    if (in_map && !was_in) {
+      differ.joined.push_back(s.id);
+    } else if (!in_map && was_in) {
+      differ.left.push_back(s.id);
+    } else if (in_map) {
+      differ.moved.push_back(s.id);
       differ.max_moved_m = std::max(differ.max_moved_m, moved);
+      differ.max_turned_deg =
+          std::max(differ.max_turned_deg,
+                   std::abs(rad2deg(std::remainder(s.placed.yaw - was.yaw, 2 * M_PI))));
     }
   }
   if (differ.poses.empty()) return;
-  spdlog::warn(
-      "{} scans are not where the session's latest poses had them (up to {:.3f} m): "
-      "recorded as a new revision",
-      differ.poses.size(), differ.max_moved_m);
-  try {
-    session_.record_pose_revision(differ.poses);
-  } catch (const SessionStoreError& failure) {
-    spdlog::error("the resumed poses could not be recorded: {}", failure.what());
-  }
+  spdlog::warn("{} scans are not where the session's latest poses had them: a new revision",
+               differ.poses.size());
+  // As any correction: recorded, and told to the pages, which fetch those scans again.
+  record_correction(differ);
 }
 
 std::size_t ScanIntake::pending() const {
@@ -349,6 +354,13 @@ void ScanIntake::rebuild_map() {
     }
   } catch (const std::exception& e) {
     spdlog::error("the map could not be rebuilt: {}", e.what());
+  }
+  // Without the scan taken out (or with the one put back) the graph may place the others
+  // differently: recorded as a revision where it does.
+  try {
+    resume_poses();
+  } catch (const std::exception& e) {
+    spdlog::error("the rebuilt map's poses could not be recorded: {}", e.what());
   }
   {
     std::lock_guard lock(mutex_);

@@ -115,7 +115,8 @@ class ScanIntake {
   void publish_plans(std::vector<PlanRecord> plans, const std::string& first);
   // A correction of the map: a revision of the poses in the session and `map_corrected`.
   void record_correction(const MapCorrected& corrected);
-  // After a restart: records the poses where they differ from the session's latest revision.
+  // After a restart or a rebuild: records the poses where they differ from the session's latest
+  // revision.
   void resume_poses();
   // A scan brought back within this of its recorded pose is where it was.
   static constexpr double kResumeToleranceM = 0.02;
