@@ -146,6 +146,23 @@ TEST_F(MissionPipelineTest, AScanNothingTiesInStaysOutOfTheMap) {
   EXPECT_EQ(mission.poses().size(), 2u);
 }
 
+// With exact pose sensors (a total station, a simulation without noise) a scan no match places
+// joins the map where it is reported: the sensors alone place it within the map's accuracy.
+TEST_F(MissionPipelineTest, ExactSensorsPlaceAScanNoMatchPlaced) {
+  MissionConfig c = config();
+  c.pose_noise = PoseNoise{0, 0, 0, OdometryModel::kAbsolute};
+  MissionPipeline mission(c);
+  mission.add(scan_at(at(-15, -8, 0), 1), {at(-15, -8, 0), at(-15, -8, 0)});
+  PointCloud few;  // too few points to match anything
+  for (int i = 0; i < 20; ++i) few.push_back({static_cast<float>(i), 3.0f, 0.0f}, {1, 2, 3});
+  mission.add(few, {at(10, 5, 0), at(10, 5, 0)});
+  EXPECT_TRUE(mission.anchored(1));
+  EXPECT_TRUE(mission.in_map(1));
+  EXPECT_NEAR(mission.poses()[1].x, 10, 1e-3);
+  EXPECT_EQ(mission.graph()->edge_origin(mission.graph()->graph().edges().size() - 1), "sensors");
+  // Sensors that err by a metre do not: that scan waits (AScanNothingTiesInStaysOutOfTheMap).
+}
+
 TEST_F(MissionPipelineTest, WithMatchingOffScansStayWhereTheRobotSays) {
   MissionConfig c = config();
   c.matching.reset();
