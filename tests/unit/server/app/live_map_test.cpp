@@ -9,29 +9,22 @@
 
 #include "app/live_map.hpp"
 #include "ground_pose.hpp"
+#include "quick_yard.hpp"
 #include "scanplan/compression/draco_codec.hpp"
-#include "scanplan/sim/simulated_scanner.hpp"
 
 namespace scanplan::server {
 namespace {
 
 constexpr auto* at = &testing_support::ground_pose;
+using testing_support::quick_yard;
+using testing_support::quick_yard_scan;
 
 class LiveMapGraphTest : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    world_ = new World(load_world(SCANPLAN_SOURCE_DIR "/samples/worlds/yard.json"));
-    world_->scanner.rotation_step_deg = 1.0;  // a quarter of the points: quick, still matchable
-    caster_ = new RayCaster(*world_);
-  }
-  static void TearDownTestSuite() {
-    delete caster_;
-    delete world_;
-  }
   LiveMapGraphTest() : map_(plans_, config()) {}
   static MissionConfig config() {
     MissionConfig c;
-    c.mapping.sensor_height_m = world_->scanner.mount_height_m;
+    c.mapping.sensor_height_m = quick_yard().scanner.mount_height_m;
     c.planner.policy = PlannerPolicy::kExhaustive;
     return c;
   }
@@ -42,7 +35,7 @@ class LiveMapGraphTest : public ::testing::Test {
     s.robot = "robot1";
     s.estimated = reported;
     s.placed = reported;
-    const PointCloud cloud = simulate_scan(*caster_, world_->scanner, truth, id);
+    const PointCloud cloud = quick_yard_scan(truth, id);
     s.points = cloud.size();
     if (match) {
       if (const auto m = map_.place(cloud, reported, s.robot)) {
@@ -53,13 +46,9 @@ class LiveMapGraphTest : public ::testing::Test {
     }
     return map_.add(s, cloud);
   }
-  static World* world_;
-  static RayCaster* caster_;
   PlanBook plans_;
   LiveMap map_;
 };
-World* LiveMapGraphTest::world_ = nullptr;
-RayCaster* LiveMapGraphTest::caster_ = nullptr;
 
 Eigen::Vector3d centroid(const PointCloud& c) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -100,7 +89,7 @@ TEST_F(LiveMapGraphTest, AScanTiedInLaterJoinsTheMapWhereItBelongs) {
   const auto chunk = map_.encoded_chunk(2);
   ASSERT_TRUE(chunk);
   const PointCloud decoded = decode_draco(*chunk);
-  const PointCloud own = simulate_scan(*caster_, world_->scanner, at(-5, -9, 0), 2);
+  const PointCloud own = quick_yard_scan(at(-5, -9, 0), 2);
   const Eigen::Vector3d truth = at(-5, -9, 0).isometry() * centroid(own);
   EXPECT_LT((centroid(decoded) - truth).norm(), 0.05);
   EXPECT_GT(map_.point_count(), points_one + decoded.size());
