@@ -20,6 +20,7 @@ export class MapChunks {
     this.held = new Set(); // scan ids in the view
     this.pending = new Set(); // being fetched or decoded
     this.stale = new Set(); // pending, but the scan moved since: fetched again once in
+    this.wanted = null; // the ids of the latest sync
     this.failed = new Map(); // scan id -> message
     this.syncing = false;
     this.resyncWanted = null;
@@ -73,6 +74,7 @@ export class MapChunks {
   /** Forgets every chunk (a different session on the server). */
   reset() {
     this.held.clear();
+    this.stale.clear();
     this.failed.clear();
     this.error = null;
     this.onChange();
@@ -84,8 +86,10 @@ export class MapChunks {
     try {
       const d = await this._decode(buffer, id);
       this.pending.delete(id);
-      // Drawn all the same (nearer than nothing); the next sync fetches it where it now is.
-      if (!this.stale.delete(id)) this.held.add(id);
+      // Drawn all the same (nearer than nothing), and fetched again where it now is.
+      const stale = this.stale.delete(id);
+      if (!stale) this.held.add(id);
+      else if (this.wanted) queueMicrotask(() => this.sync(this.wanted));
       this.failed.delete(id);
       this.onChunk({ id, count: d.count, positions: d.positions, colors: d.colors, min: d.min, max: d.max, source });
     } catch (e) {
@@ -123,6 +127,7 @@ export class MapChunks {
    * longer in the map (a scan the operator took out). Calls made while one runs are merged.
    */
   async sync(ids) {
+    this.wanted = ids;
     const wanted = new Set(ids);
     for (const id of [...this.held]) {
       if (wanted.has(id)) continue;
