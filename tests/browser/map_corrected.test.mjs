@@ -28,10 +28,14 @@ test('the page draws the map as the graph has it and says when it was corrected'
     const ws = new WebSocket(`${stack.url.replace('http', 'ws')}/api/v1/events?token=${stack.viewerToken}`);
     await new Promise((resolve, reject) => { ws.on('open', resolve); ws.on('error', reject); });
     const corrections = [];
+    let lastScan = 0;
+    let settled = false; // the plans after the last scan: every event of that scan came before
     ws.on('message', (data, isBinary) => {
       if (isBinary) return;
       const e = JSON.parse(data.toString());
       if (e.type === 'map_corrected') corrections.push(e);
+      if (e.type === 'map_updated') lastScan = e.scan;
+      if (e.type === 'plan_done' && lastScan === uploads.length) settled = true;
     });
     for (const u of uploads) {
       const r = await stack.api('POST', u.path, { body: u.body });
@@ -42,16 +46,20 @@ test('the page draws the map as the graph has it and says when it was corrected'
       return a.scans.length === 4 && a.pending === 0 ? a.scans : undefined;
     }, 120000);
     const inMap = scans.filter((s) => s.in_map).map((s) => s.id);
-    await waitForData(page, `the ${inMap.length} scans in the map drawn, and no other`,
-      (n) => document.body.dataset.chunks === String(n) && !document.body.dataset.status?.startsWith('loading'), inMap.length, 60000);
-    await waitForData(page, 'the correction in the log',
-      () => [...document.querySelectorAll('#log li')].some((li) => li.textContent.includes('map corrected')));
+    await stack.waitFor('the last scan\'s events', async () => settled || undefined, 30000);
+    assert.ok(corrections.length >= 1, 'the graph corrected the map');
+    // The page had every correction the server made, and then holds each scan in the map where
+    // the server has it now.
+    await waitForData(page, `all ${corrections.length} corrections in the log`,
+      (n) => [...document.querySelectorAll('#log li')].filter((li) => li.textContent.includes('map corrected')).length === n,
+      corrections.length);
+    await waitForData(page, `the ${inMap.length} scans in the map drawn where they are, and no other`,
+      (n) => document.body.dataset.chunks === String(n) && document.body.dataset.mapCurrent === 'true', inMap.length, 60000);
     const said = await page.locator('#log li', { hasText: 'map corrected' }).first().textContent();
     assert.match(said, /map corrected: scans? [0-9]/);
     // The chunks came over the WebSocket as the scans joined; a scan the graph moved or tied in
     // later was fetched (again) over REST, where it now is.
     ws.close();
-    assert.ok(corrections.length >= 1, 'the graph corrected the map');
     const fetched = new Set(requests.filter((r) => r.path === '/api/v1/map.drc')
       .map((r) => Number(new URLSearchParams(r.search).get('until'))));
     for (const id of new Set(corrections.flatMap((c) => [...c.scans, ...c.joined]))) {

@@ -157,6 +157,8 @@ function render() {
   body.dataset.points = String(view ? view.pointCount : 0);
   body.dataset.drawn = String(view ? view.drawnCount : 0);
   body.dataset.chunks = String(view ? view.chunkCount : 0);
+  // Every scan in the map drawn where the server has it now (after a correction: fetched again).
+  body.dataset.mapCurrent = String(chunks.current);
   body.dataset.role = state.role;
   body.dataset.error = err ? err.message : '';
   setText($('conn-state'), conn);
@@ -287,7 +289,7 @@ async function refreshScans() {
     mission.setScans(state.scans);
     render();
     // A scan waiting for a match that ties it in may be metres off: not drawn until it joins.
-    if (view) await chunks.sync(state.scans.filter((s) => s.in_map !== false).map((s) => s.id));
+    if (view) await chunks.sync(state.scans.filter((s) => s.in_map !== false));
   } catch (e) {
     if (!toError(e).network) console.warn('scans:', e);
   }
@@ -429,6 +431,8 @@ function onEvent(e) {
         log.add({ ...e, kind: 'map_corrected' });
         // Fetched again where they now are (refreshScans syncs the chunks).
         chunks.forget([...(e.scans || []), ...(e.joined || [])]);
+      } else {
+        chunks.outdated();
       }
       soon(() => {
         refreshSession();
@@ -438,6 +442,7 @@ function onEvent(e) {
       });
       break;
     case 'map_updated':
+      chunks.outdated();
       mission.onMapUpdated(e);
       chart.set(e.scan, e);
       soon(() => {

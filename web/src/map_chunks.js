@@ -2,7 +2,10 @@
 // worker (map_chunks_worker.js). Chunks come from the WebSocket (one binary frame per new scan)
 // or, for scans the page missed (first load, a lost connection, chunks the server dropped for a
 // slow link), from GET /api/v1/map.drc?since=A&until=B: the points of the scans A < id <= B, so a
-// page never downloads a scan twice.
+// page never downloads a scan twice unless the pose graph moved it. Each chunk held is keyed by
+// the scan's placed pose in the listing it was fetched after: a listing with another pose (a
+// correction the page missed while disconnected, or one that came while the chunk was on its way)
+// fetches it again.
 import { ApiError, getBinaryWithHeaders } from './api.js';
 
 const MAP_TIMEOUT_MS = 120000;
@@ -17,10 +20,11 @@ export class MapChunks {
     this.onChunk = onChunk;
     this.onChange = onChange;
     this.onRemove = onRemove;
-    this.held = new Set(); // scan ids in the view
+    this.held = new Map(); // scan id in the view -> its placed pose's key (null: came as it joined)
     this.pending = new Set(); // being fetched or decoded
     this.stale = new Set(); // pending, but the scan moved since: fetched again once in
-    this.wanted = null; // the ids of the latest sync
+    this.wanted = null; // the scans of the latest sync
+    this.behind = false; // the map changed on the server since the latest sync
     this.failed = new Map(); // scan id -> message
     this.syncing = false;
     this.resyncWanted = null;
@@ -71,6 +75,18 @@ export class MapChunks {
     return this.pending.size;
   }
 
+  /** True when every scan of the latest sync is held where the server has it now. */
+  get current() {
+    if (!this.wanted || this.behind || this.syncing || this.pending.size || this.failed.size) return false;
+    return this.held.size === this.wanted.length && this.wanted.every((s) => this.held.get(s.id) === s.key);
+  }
+
+  /** The map changed on the server (an event said so): not current until the next sync. */
+  outdated() {
+    this.behind = true;
+    this.onChange();
+  }
+
   /** Forgets every chunk (a different session on the server). */
   reset() {
     this.held.clear();
@@ -80,7 +96,7 @@ export class MapChunks {
     this.onChange();
   }
 
-  async _take(id, buffer, source) {
+  async _take(id, buffer, source, key = null) {
     this.pending.add(id);
     this.onChange();
     try {
@@ -88,8 +104,9 @@ export class MapChunks {
       this.pending.delete(id);
       // Drawn all the same (nearer than nothing), and fetched again where it now is.
       const stale = this.stale.delete(id);
-      if (!stale) this.held.add(id);
-      else if (this.wanted) queueMicrotask(() => this.sync(this.wanted));
+      if (!stale) this.held.set(id, key);
+      const want = this.wanted?.find((s) => s.id === id);
+      if (stale || (want && key !== null && want.key !== key)) queueMicrotask(() => this._sync(this.wanted, false));
       this.failed.delete(id);
       this.onChunk({ id, count: d.count, positions: d.positions, colors: d.colors, min: d.min, max: d.max, source });
     } catch (e) {
@@ -105,11 +122,13 @@ export class MapChunks {
    * sync brings each one where it now is (replacing it in the view).
    */
   forget(ids) {
+    this.behind = true;
     for (const id of ids) {
       this.held.delete(id);
       this.failed.delete(id);
       if (this.pending.has(id)) this.stale.add(id);
     }
+    this.onChange();
   }
 
   /** A binary frame from the WebSocket (op 1). */
@@ -122,30 +141,41 @@ export class MapChunks {
   }
 
   /**
-   * Fetches the chunks of the scans in `ids` (the session's scan ids, ascending) that the page
-   * does not hold, one scan at a time, oldest first, and drops those it holds that are no
-   * longer in the map (a scan the operator took out). Calls made while one runs are merged.
+   * Fetches the chunks of `scans` (the session's scans in the map, ascending ids, each
+   * {id, placed}) that the page does not hold where the server has them, one scan at a time,
+   * oldest first, and drops those it holds that are no longer in the map (a scan the operator
+   * took out, or one the graph set outside). Calls made while one runs are merged.
    */
-  async sync(ids) {
-    this.wanted = ids;
-    const wanted = new Set(ids);
-    for (const id of [...this.held]) {
-      if (wanted.has(id)) continue;
-      this.held.delete(id);
-      this.onRemove(id);
+  sync(scans) {
+    return this._sync(scans.map((s) => ({ id: s.id, key: JSON.stringify(s.placed ?? null) })));
+  }
+
+  // `listed`: the list is the server's latest (not one the page held already).
+  async _sync(list, listed = true) {
+    this.wanted = list;
+    if (listed) this.behind = false;
+    const wanted = new Map(list.map((s) => [s.id, s.key]));
+    for (const [id, key] of [...this.held]) {
+      if (!wanted.has(id)) {
+        this.held.delete(id);
+        this.onRemove(id);
+      } else if (key === null) {
+        // Came over the WebSocket as the scan joined; a move since came as map_corrected.
+        this.held.set(id, wanted.get(id));
+      }
     }
     if (this.syncing) {
-      this.resyncWanted = ids;
+      this.resyncWanted = list;
       return;
     }
     this.syncing = true;
     this.onChange();
     try {
-      let list = ids;
-      while (list) {
+      let next = list;
+      while (next) {
         this.resyncWanted = null;
-        await this._fetchMissing(list);
-        list = this.resyncWanted;
+        await this._fetchMissing(next);
+        next = this.resyncWanted;
       }
       this.error = null;
     } catch (e) {
@@ -156,23 +186,25 @@ export class MapChunks {
     }
   }
 
-  async _fetchMissing(ids) {
-    const sorted = [...ids].sort((a, b) => a - b);
+  async _fetchMissing(scans) {
+    const sorted = [...scans].sort((a, b) => a.id - b.id);
     const decodes = [];
+    const current = (s) => this.held.get(s.id) === s.key || this.pending.has(s.id);
     for (let k = 0; k < sorted.length; k++) {
-      const id = sorted[k];
-      if (this.held.has(id) || this.pending.has(id)) continue;
+      const { id, key } = sorted[k];
+      if (current(sorted[k])) continue;
       // since = the scan before it (ids may have gaps), so exactly this scan comes back.
-      const since = k > 0 ? sorted[k - 1] : 0;
+      const since = k > 0 ? sorted[k - 1].id : 0;
       const res = await getBinaryWithHeaders(`/api/v1/map.drc?since=${since}&until=${id}`, { timeoutMs: MAP_TIMEOUT_MS });
-      if (this.held.has(id) || this.pending.has(id)) continue; // the WebSocket was quicker
+      // The WebSocket was quicker (a chunk that came as the scan joined is where it is listed).
+      if (current(sorted[k]) || this.held.get(id) === null) continue;
       if (!res.body) {
-        this.held.add(id); // no points in it
+        this.held.set(id, key); // no points in it
         continue;
       }
       this.stats.restChunks += 1;
       this.stats.bytes += res.body.byteLength;
-      decodes.push(this._take(id, res.body, 'rest'));
+      decodes.push(this._take(id, res.body, 'rest', key));
     }
     await Promise.all(decodes);
   }
