@@ -73,6 +73,7 @@ json candidate_json(const CandidateRecord& r, const std::string& robot, std::uin
   if (c.registrability) {
     registrability = {{"overlap_share", c.registrability->overlap_share},
                       {"pose_fixing", c.registrability->pose_fixing},
+                      {"reach", c.registrability->reach},
                       {"factor", c.registrability->factor}};
   }
   return {{"id", r.id},

@@ -269,7 +269,7 @@ std::vector<PlanRecord> LiveMap::make_plans() const {
   for (const auto& [robot, goal] : driving) claims.push_back(goal);
   std::vector<FleetRobot> robots;
   for (const auto& [robot, at] : scan_pose_of_) {
-    if (!driving.count(robot)) robots.push_back({robot, {at.x, at.y, at.z}});
+    if (!driving.count(robot)) robots.push_back({robot, {at.x, at.y, at.z}, {}});
   }
   const PlannerConfig& planner = mission_.planner();
   std::vector<PlanRecord> records;

@@ -84,8 +84,10 @@ nlohmann::json forecast_json(const LoopStep* previous) {
   const std::optional<Registrability>& r =
       previous->candidates.at(*previous->chosen).registrability;
   if (!r) return nullptr;
-  return {
-      {"overlap_share", r->overlap_share}, {"pose_fixing", r->pose_fixing}, {"factor", r->factor}};
+  return {{"overlap_share", r->overlap_share},
+          {"pose_fixing", r->pose_fixing},
+          {"reach", r->reach},
+          {"factor", r->factor}};
 }
 
 // One scan as summary.json lists it (DESIGN.md "CLI"): where the robot said it was, where the

@@ -13,6 +13,9 @@
 namespace scanplan {
 namespace {
 
+// The simulated robot's name in the scan graph.
+const std::string kTrack = "robot";
+
 // The coverage denominator: MLS cells of the target region holding ground the robot could
 // reach from its start in the true world (DESIGN.md: coverage_pct), as cells of the map, whose
 // frame (the first scan's placed pose) is `map_from_world` from the world's.
@@ -67,7 +70,6 @@ std::optional<std::size_t> drive_to_best(const WorldTraversability& trav,
 
 // The scan matched against the map and joined, the graph optimised: step's poses and match.
 void place(MissionPipeline& mission, const PointCloud& cloud, LoopStep& step) {
-  static const std::string kTrack = "robot";
   step.prior_pose = mission.prior(step.reported_pose, kTrack);
   step.matched_pose = step.prior_pose;
   Placement where{step.reported_pose, step.prior_pose, false};
@@ -270,7 +272,8 @@ LoopResult run_closed_loop(
       const Pose& at = mission.in_map(mission.poses().size() - 1) ? step.placed_pose
                                                                   : pipeline.scan_poses().back();
       const Plan plan = mission.plan_from(
-          {at.x, at.y, at.z}, config.planner.seed * 1000003u + static_cast<std::uint64_t>(scan));
+          {at.x, at.y, at.z}, config.planner.seed * 1000003u + static_cast<std::uint64_t>(scan),
+          kTrack);
       step.plan_ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       step.candidates = plan.ranked;

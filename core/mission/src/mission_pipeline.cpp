@@ -30,10 +30,8 @@ MapMatchConfig widened(MapMatchConfig config, const MoveUncertainty& prior,
   config.registration = widened(config.registration, prior);
   if (!correct_as_far) return config;
   config.max_correction_m =
-      std::max(config.max_correction_m,
-               std::min(3 * std::sqrt(2.0) * prior.xy_m, std::sqrt(2.0) * kWidestSearchM));
-  config.max_correction_deg =
-      std::max(config.max_correction_deg, std::min(3 * prior.yaw_deg, kWidestSearchDeg));
+      std::max(config.max_correction_m, 1.5 * std::sqrt(2.0) * kWidestSearchM);
+  config.max_correction_deg = std::max(config.max_correction_deg, kWidestSearchDeg + 10);
   return config;
 }
 
@@ -316,8 +314,26 @@ std::vector<FleetPlan> MissionPipeline::plan(const std::vector<FleetRobot>& robo
                                              std::vector<Eigen::Vector3d> claimed) const {
   if (!has_map()) return {};
   for (const Eigen::Vector3d& p : unplaced_scan_points()) claimed.push_back(p);
-  return plan_fleet(mapping_.map(), *mapping_.target(), mapping_.scan_points(), robots,
+  std::vector<FleetRobot> drifting = robots;
+  for (FleetRobot& r : drifting) r.drift = drift_of(r.id);
+  return plan_fleet(mapping_.map(), *mapping_.target(), mapping_.scan_points(), drifting,
                     std::move(claimed), config_.planner, anchored_map());
+}
+
+std::optional<DriveDrift> MissionPipeline::drift_of(const std::string& track) const {
+  if (!graph_ || config_.pose_noise.model != OdometryModel::kDrift) return std::nullopt;
+  const auto latest = graph_->last_of(track);
+  if (!latest) return std::nullopt;
+  DriveDrift d;
+  d.xy_per_m = config_.pose_noise.xy_drift_fraction;
+  d.yaw_deg_per_m = config_.pose_noise.yaw_drift_deg_per_10m / 10;
+  if (!graph_->anchored(*latest)) {
+    if (const auto u = graph_->prior_uncertainty(track, graph_->reported(*latest))) {
+      d.start_xy_m = u->xy_m;
+      d.start_yaw_deg = u->yaw_deg;
+    }
+  }
+  return d;
 }
 
 // Where the scans the map does not hold were taken, as the graph has them: the planner counts
@@ -332,7 +348,8 @@ std::vector<Eigen::Vector3d> MissionPipeline::unplaced_scan_points() const {
   return out;
 }
 
-Plan MissionPipeline::plan_from(const Eigen::Vector3d& robot, std::uint64_t seed) const {
+Plan MissionPipeline::plan_from(const Eigen::Vector3d& robot, std::uint64_t seed,
+                                const std::string& track) const {
   if (!has_map()) return {};
   PlannerConfig planner = config_.planner;
   planner.seed = seed;
@@ -341,6 +358,8 @@ Plan MissionPipeline::plan_from(const Eigen::Vector3d& robot, std::uint64_t seed
   in.anchored = anchored_map();
   const std::vector<Eigen::Vector3d> unplaced = unplaced_scan_points();
   if (!unplaced.empty()) in.claimed = &unplaced;
+  const std::optional<DriveDrift> drift = drift_of(track);
+  if (drift) in.drift = &*drift;
   return plan_next_scan(in, planner);
 }
 

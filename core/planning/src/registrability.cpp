@@ -110,4 +110,27 @@ Registrability RegistrabilityField::Forecast::result() const {
   return out;
 }
 
+namespace {
+
+// The share of 3σ of the pose after driving d metres that the search reaches.
+double reached(const DriveDrift& drift, double d, const RegistrabilityConfig& config) {
+  // A heading already off swings the whole drive sideways.
+  const double swing = d * drift.start_yaw_deg * M_PI / 180;
+  const double xy = std::sqrt(drift.start_xy_m * drift.start_xy_m +
+                              std::pow(drift.xy_per_m * d, 2) + swing * swing);
+  const double yaw = std::hypot(drift.start_yaw_deg, drift.yaw_deg_per_m * d);
+  double s = 1;
+  if (xy > 0) s = std::min(s, config.reach_xy_m / (3 * xy));
+  if (yaw > 0) s = std::min(s, config.reach_yaw_deg / (3 * yaw));
+  return s;
+}
+
+}  // namespace
+
+double drive_reach(const DriveDrift& drift, double travel_m, const RegistrabilityConfig& config) {
+  // Relative to staying put: a robot already beyond the search (its latest scan not placed) is
+  // no less likely to be placed after a short drive, and a long one still costs it.
+  return reached(drift, std::max(0.0, travel_m), config) / reached(drift, 0, config);
+}
+
 }  // namespace scanplan

@@ -76,6 +76,8 @@ void check_config(const PlannerConfig& c) {
     fail("registrability.min_pose_fixing must be greater than zero");
   if (!(r.floor_share >= 0 && r.floor_share <= 1))
     fail("registrability.floor_share must be in [0, 1]");
+  if (!(r.reach_xy_m > 0) || !(r.reach_yaw_deg > 0))
+    fail("registrability.reach_xy_m and reach_yaw_deg must be greater than zero");
   if (!(r.near_range_m > 0 && std::isfinite(r.near_range_m)))
     fail("registrability.near_range_m must be greater than zero");
   if (!std::isfinite(r.wall_min_extent_m)) fail("registrability.wall_min_extent_m must be finite");
@@ -115,6 +117,9 @@ struct Sites {
   std::vector<CellIndex> cell;
   std::vector<float> floor_z;
   std::vector<double> travel_m;
+  // drive_reach of the drive there; empty without drifting odometry or forecasts.
+  std::vector<double> reach;
+  double floor_share = 0;        // RegistrabilityConfig::floor_share
   CellGrid<std::int32_t> index;  // the movable region's geometry; -1 where no site
   std::size_t size() const { return cell.size(); }
   std::int32_t at(CellIndex c) const {
@@ -194,6 +199,27 @@ using Scorer = std::function<double(std::int32_t site, const ScanGain& gain)>;
 // A policy's score once the best F of a first look over the region is known.
 using ScorerFor = std::function<Scorer(double best_f)>;
 
+// F at a site, its forecast with the drive there.
+ScanGain site_gain(const ScanGainEvaluator& gain, const Sites& sites, std::int32_t site,
+                   VisibilityPredictor::Workspace& ws) {
+  const auto u = static_cast<std::size_t>(site);
+  ScanGain g = gain.at(sites.cell[u], sites.floor_z[u], ws);
+  if (g.registrability && !sites.reach.empty()) {
+    Registrability& r = *g.registrability;
+    r.reach = sites.reach[u];
+    if (r.reach < 1) r.factor = std::max(sites.floor_share, r.factor * r.reach * r.reach);
+  }
+  return g;
+}
+
+// With drifting odometry, each site's drive_reach.
+void forecast_drives(Sites& sites, const DriveDrift* drift, const RegistrabilityConfig& cfg) {
+  if (!drift || !cfg.enabled) return;
+  sites.floor_share = cfg.floor_share;
+  sites.reach.reserve(sites.size());
+  for (const double d : sites.travel_m) sites.reach.push_back(drive_reach(*drift, d, cfg));
+}
+
 double by_gain(std::int32_t, const ScanGain& g) {
   return registrable_f(g);
 }
@@ -211,9 +237,8 @@ std::vector<Scored> evaluate_sites(const ScanGainEvaluator& gain, const Sites& s
     auto ws = gain.workspace();
 #pragma omp for schedule(dynamic, 4)
     for (std::size_t k = 0; k < which.size(); ++k) {
-      const auto s = static_cast<std::size_t>(which[k]);
       out[k].site = which[k];
-      out[k].gain = gain.at(sites.cell[s], sites.floor_z[s], ws);
+      out[k].gain = site_gain(gain, sites, which[k], ws);
       out[k].score = score(which[k], out[k].gain);
     }
   }
@@ -336,8 +361,7 @@ std::vector<Scored> climb(const ScanGainEvaluator& gain, const Sites& sites, std
   const auto value_at = [&](std::int32_t s) {
     const auto it = memo.find(s);
     if (it != memo.end()) return it->second;
-    const auto u = static_cast<std::size_t>(s);
-    const ScanGain g = gain.at(sites.cell[u], sites.floor_z[u], ws);
+    const ScanGain g = site_gain(gain, sites, s, ws);
     const double v = score(s, g);
     memo.emplace(s, v);
     seen.push_back({s, g, v});
@@ -629,8 +653,9 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
 
   const TravelMap travel = travel_map(in.map, plan.movable, start, cfg.movable,
                                       cfg.stay_in_target ? &in.target : nullptr);
-  const Sites sites = collect_sites(in.map, plan.movable, travel,
-                                    cfg.stay_in_target ? &in.target : nullptr, keep_out);
+  Sites sites = collect_sites(in.map, plan.movable, travel,
+                              cfg.stay_in_target ? &in.target : nullptr, keep_out);
+  forecast_drives(sites, in.drift, cfg.registrability);
   if (sites.size() == 0) return finish();
   // With claims, F is taken against the segmentation as it will be after the other robots'
   // scans; plan.regions stays the map's own.

@@ -107,11 +107,22 @@ struct Candidate {
   double score;
 };
 
-// The best of `found` that lie apart from each other, best first.
-std::vector<Candidate> distinct_peaks(std::vector<Candidate> found, std::size_t count, double min_m,
-                                      double min_rad) {
+double offset_weight(const PoseSearchConfig& c, double metres, double radians) {
+  double e = 0;
+  if (c.prior_sigma_xy_m > 0) e += std::pow(metres / c.prior_sigma_xy_m, 2);
+  if (c.prior_sigma_yaw_deg > 0) e += std::pow(rad2deg(radians) / c.prior_sigma_yaw_deg, 2);
+  return std::exp(-0.5 * e);
+}
+
+// The best of `found` that lie apart from each other, best first (by score times the prior).
+std::vector<Candidate> distinct_peaks(std::vector<Candidate> found, std::size_t count,
+                                      const PoseSearchConfig& config) {
+  const double min_m = config.min_separation_m, min_rad = deg2rad(config.min_separation_deg);
+  const auto ranked = [&](const Candidate& a) {
+    return a.score * offset_weight(config, std::hypot(a.dx, a.dy), a.yaw);
+  };
   std::sort(found.begin(), found.end(),
-            [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+            [&](const Candidate& a, const Candidate& b) { return ranked(a) > ranked(b); });
   std::vector<Candidate> out;
   for (const auto& c : found) {
     if (out.size() >= count) break;
@@ -163,6 +174,14 @@ std::vector<double> yaw_steps(double centre, double half_range, double step) {
 
 }  // namespace
 
+double prior_weight(const PoseSearchConfig& config, const Eigen::Isometry3d& initial,
+                    const Eigen::Isometry3d& pose) {
+  const Eigen::Isometry3d off = initial.inverse() * pose;
+  const Eigen::Vector3d x = off.linear() * Eigen::Vector3d::UnitX();
+  return offset_weight(config, (pose.translation() - initial.translation()).head<2>().norm(),
+                       std::atan2(x.y(), x.x()));
+}
+
 std::vector<PoseHypothesis> search_poses(const PointCloud& target, const PointCloud& source,
                                          const Eigen::Isometry3d& initial,
                                          const PoseSearchConfig& config) {
@@ -184,14 +203,12 @@ std::vector<PoseHypothesis> search_poses(const PointCloud& target, const PointCl
   const Eigen::Vector3f centre = T.translation();
 
   const double step = deg2rad(config.yaw_step_deg);
-  const double min_rad = deg2rad(config.min_separation_deg);
   const std::size_t wanted = static_cast<std::size_t>(std::max(config.hypotheses, 1));
   std::vector<Candidate> found;
   const int reach = static_cast<int>(std::ceil(config.xy_range_m / coarse.cell()));
   scan_window(coarse, placed, centre, yaw_steps(0, deg2rad(config.yaw_range_deg), 2 * step), 0, 0,
               reach, 1, found);
-  const std::vector<Candidate> rough =
-      distinct_peaks(std::move(found), 3 * wanted, config.min_separation_m, min_rad);
+  const std::vector<Candidate> rough = distinct_peaks(std::move(found), 3 * wanted, config);
 
   std::vector<Candidate> refined;
   for (const Candidate& c : rough) {
@@ -204,8 +221,7 @@ std::vector<PoseHypothesis> search_poses(const PointCloud& target, const PointCl
         [](const Candidate& a, const Candidate& b) { return a.score < b.score; }));
   }
   std::vector<PoseHypothesis> out;
-  for (const Candidate& c :
-       distinct_peaks(std::move(refined), wanted, config.min_separation_m, min_rad)) {
+  for (const Candidate& c : distinct_peaks(std::move(refined), wanted, config)) {
     Eigen::Isometry3d move = Eigen::Isometry3d::Identity();
     const Eigen::Vector3d pivot = centre.cast<double>();
     move.translate(pivot + Eigen::Vector3d(c.dx, c.dy, 0));

@@ -87,17 +87,16 @@ bool holds_on_restart(const GicpMatcher& gicp, const Eigen::Isometry3d& at,
 }
 
 // Another result that passed the check almost as well as `best` but lies elsewhere: why the
-// match is ambiguous, or nothing.
+// match is ambiguous, or nothing. How well is the inlier count times the prior (prior_weight).
 std::optional<std::string> ambiguous(
-    const Eigen::Isometry3d& best, std::size_t inliers,
-    const std::vector<std::pair<Eigen::Isometry3d, std::size_t>>& passed,
-    const PoseSearchConfig& c) {
-  for (const auto& [other, other_inliers] : passed) {
+    const Eigen::Isometry3d& best, double support,
+    const std::vector<std::pair<Eigen::Isometry3d, double>>& passed, const PoseSearchConfig& c) {
+  for (const auto& [other, other_support] : passed) {
     const Eigen::Isometry3d off = best.inverse() * other;
     const double metres = off.translation().head<2>().norm();
     const double degrees = rad2deg(Eigen::AngleAxisd(off.linear()).angle());
     if ((metres > c.min_separation_m || degrees > c.min_separation_deg) &&
-        static_cast<double>(other_inliers) >= c.ambiguity_ratio * static_cast<double>(inliers)) {
+        other_support >= c.ambiguity_ratio * support) {
       char why[160];
       std::snprintf(why, sizeof why,
                     "ambiguous: a pose %.1f m and %.1f° away fits almost as well (a repeated "
@@ -127,27 +126,29 @@ RegistrationResult align_search_gicp(const PointCloud& target, const PointCloud&
   RegistrationResult best;
   AlignmentQuality best_q;
   int best_rank = -1;
-  std::size_t best_inliers = 0;
+  double best_support = 0;  // inliers times the prior
   int iterations = 0;
   const bool check_ambiguity = c.search.ambiguity_ratio > 0;
-  std::vector<std::pair<Eigen::Isometry3d, std::size_t>> passed;  // transform, inliers
+  std::vector<std::pair<Eigen::Isometry3d, double>> passed;  // transform, support
   for (const PoseHypothesis& start : starts) {
     RegistrationResult r = gicp.align(start.transform, c.dof);
     iterations += r.iterations;
     const AlignmentQuality q = judge.evaluate(sample, r.transform, c.dof, c.score_max_distance_m,
                                               c.inlier_distance_m, r.converged);
     const int rank = r.converged ? (rejection(q, c) ? 1 : 2) : 0;
-    if (rank == 2) passed.emplace_back(r.transform, q.inliers);
-    if (rank > best_rank || (rank == best_rank && q.inliers > best_inliers)) {
+    const double support =
+        static_cast<double>(q.inliers) * prior_weight(c.search, initial, r.transform);
+    if (rank == 2) passed.emplace_back(r.transform, support);
+    if (rank > best_rank || (rank == best_rank && support > best_support)) {
       best = std::move(r);
       best_q = q;
       best_rank = rank;
-      best_inliers = q.inliers;
+      best_support = support;
     }
     if (best_rank == 2 && !check_ambiguity) break;
   }
   if (best_rank == 2 && check_ambiguity) {
-    if (const auto rival = ambiguous(best.transform, best_inliers, passed, c.search)) {
+    if (const auto rival = ambiguous(best.transform, best_support, passed, c.search)) {
       best.converged = false;
       best.message = *rival;
     }

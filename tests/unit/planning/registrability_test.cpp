@@ -85,5 +85,35 @@ TEST(Registrability, TheOverlapIsTheShareOfTheScanOnTheAnchoredMap) {
   EXPECT_EQ(forecast_at_centre(MlsMap{}, off).factor, 1.0);
 }
 
+// With odometry drifting 2 % of the drive and 0.3° per 10 m, the matcher's ±6 m search holds
+// 3σ of the pose up to 100 m of driving; beyond, the share falls as 1 / drive.
+TEST(Registrability, TheDriveThereMustStayWithinTheMatchersSearch) {
+  const RegistrabilityConfig cfg;
+  DriveDrift drift;
+  drift.xy_per_m = 0.02;
+  drift.yaw_deg_per_m = 0.03;
+  EXPECT_EQ(drive_reach(drift, 0, cfg), 1.0);
+  EXPECT_EQ(drive_reach(drift, 99, cfg), 1.0);
+  EXPECT_NEAR(drive_reach(drift, 150, cfg), 100.0 / 150, 1e-9);
+  EXPECT_NEAR(drive_reach(drift, 300, cfg), 100.0 / 300, 1e-9);
+  // A robot whose latest scan the map could not place starts 2 m / 3° uncertain: its heading
+  // swings every metre of the drive sideways, and even a short drive is beyond the search.
+  drift.start_xy_m = 2;
+  drift.start_yaw_deg = 3;
+  const double xy_at_40 = std::sqrt(4 + 0.8 * 0.8 + std::pow(40 * 3 * M_PI / 180, 2));
+  EXPECT_NEAR(drive_reach(drift, 40, cfg), 6 / (3 * xy_at_40), 1e-9);
+  EXPECT_LT(drive_reach(drift, 40, cfg), drive_reach(drift, 10, cfg));
+  // A robot beyond the search already (10 m σ): the drive costs it what it adds.
+  DriveDrift lost;
+  lost.start_xy_m = 10;
+  lost.xy_per_m = 0.02;
+  EXPECT_EQ(drive_reach(lost, 0, cfg), 1.0);
+  EXPECT_NEAR(drive_reach(lost, 100, cfg), 10 / std::hypot(10.0, 2.0), 1e-9);
+  // The heading alone: 0.03°/m reaches 30° at 3σ after 333 m.
+  DriveDrift turning;
+  turning.yaw_deg_per_m = 0.03;
+  EXPECT_NEAR(drive_reach(turning, 500, cfg), 30 / (3 * 15.0), 1e-9);
+}
+
 }  // namespace
 }  // namespace scanplan

@@ -299,6 +299,41 @@ TEST_F(WallYard, CandidatesCarryTheMatchForecastAndTheUnregistrableLoseTheirScor
   }
 }
 
+// With drifting odometry, a candidate a long drive away keeps the share reach² of its
+// forecast (drive_reach); one the matcher's search reaches keeps its forecast as it was.
+TEST_F(WallYard, ALongDriveOnDriftingOdometryLowersTheScore) {
+  PlannerConfig cfg;
+  cfg.policy = PlannerPolicy::kExhaustive;
+  PlanInput in = input();
+  in.anchored = map_;
+  const Plan steady = plan_next_scan(in, cfg);
+  // Drift so strong that the search reaches 3σ of the pose for 20 m of driving.
+  DriveDrift drift;
+  drift.xy_per_m = 0.1;
+  in.drift = &drift;
+  const Plan drifting = plan_next_scan(in, cfg);
+  ASSERT_FALSE(steady.ranked.empty());
+  int beyond = 0, compared = 0;
+  for (const Candidate& c : drifting.ranked) {
+    ASSERT_TRUE(c.registrability);
+    const Registrability& r = *c.registrability;
+    EXPECT_NEAR(r.reach, drive_reach(drift, c.travel_m, cfg.registrability), 1e-12);
+    EXPECT_EQ(r.reach == 1.0, c.travel_m <= 20.0) << c.travel_m;
+    beyond += r.reach < 1;
+    for (const Candidate& s : steady.ranked) {
+      if (s.position != c.position) continue;
+      ++compared;
+      EXPECT_EQ(s.registrability->reach, 1.0);
+      EXPECT_NEAR(r.factor,
+                  std::max(cfg.registrability.floor_share,
+                           s.registrability->factor * (r.reach < 1 ? r.reach * r.reach : 1.0)),
+                  1e-12);
+    }
+  }
+  EXPECT_GT(beyond, 0);
+  EXPECT_GT(compared, 0);
+}
+
 // Two robots on one map: robot A is going past the wall's end; robot B, planned next with A's
 // goal claimed, is sent elsewhere, and what A will see no longer counts for B.
 TEST_F(WallYard, AClaimedScanPointSendsTheNextRobotElsewhere) {
@@ -341,7 +376,7 @@ TEST_F(WallYard, AClaimedScanPointSendsTheNextRobotElsewhere) {
 // Two robots on one map: the spot past the wall goes to the robot nearer it, whichever is listed
 // first, and the other is sent at least claim_separation_m away.
 TEST_F(WallYard, TheFleetGivesTheBestSpotToTheNearerRobot) {
-  const FleetRobot far{"far", {40, 20, 0}}, near{"near", {47, 30, 0}};
+  const FleetRobot far{"far", {40, 20, 0}, {}}, near{"near", {47, 30, 0}, {}};
   PlannerConfig cfg;
   cfg.policy = PlannerPolicy::kExhaustive;
   const double alone = plan(PlannerPolicy::kExhaustive, 0.5).ranked.front().f;

@@ -93,11 +93,18 @@ class MissionPipeline {
   static std::shared_ptr<const PointCloud> to_map_frame(const PointCloud& scan, const Pose& placed);
 
   // Planned: the next scan point for each robot (plan_fleet, PlanInput::claimed for `claimed`,
-  // the goals of robots already driving). Empty before the first scan.
+  // the goals of robots already driving; with drifting odometry each robot's drift_of its id).
+  // Empty before the first scan.
   std::vector<FleetPlan> plan(const std::vector<FleetRobot>& robots,
                               std::vector<Eigen::Vector3d> claimed = {}) const;
-  // One robot standing at `robot` (x, y, floor z); `seed` for the policies that draw at random.
-  Plan plan_from(const Eigen::Vector3d& robot, std::uint64_t seed) const;
+  // One robot standing at `robot` (x, y, floor z), scanning as `track`; `seed` for the policies
+  // that draw at random.
+  Plan plan_from(const Eigen::Vector3d& robot, std::uint64_t seed,
+                 const std::string& track = {}) const;
+  // With the graph on drifting odometry: how uncertain `track`'s pose is after its latest scan
+  // (nothing when the map placed that scan) and how it grows as the robot drives
+  // (PlanInput::drift). Nothing otherwise, or before the track's first scan.
+  std::optional<DriveDrift> drift_of(const std::string& track) const;
 
   // New planner parameters; the segmentation and the movable region follow their thresholds.
   void set_planner(const PlannerConfig& planner);

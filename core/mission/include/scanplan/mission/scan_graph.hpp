@@ -69,7 +69,9 @@ struct MoveUncertainty {
 // the search, the likelier it spans a repeated structure, and a match that another pose farther
 // out fits as well is not believed. It never reaches beyond kWidestSearchM / _Deg. A map match
 // that corrects beyond the sensors' usual reach waits for confirmation
-// (ScanGraph::offer_match_to_map); a pairwise one is refused (max_search_shift_m).
+// (ScanGraph::offer_match_to_map); a pairwise one is refused (max_search_shift_m). Always,
+// narrow or widened, the search is told `prior` (PoseSearchConfig::prior_sigma_xy_m): of two
+// fits, the one nearer where the odometry puts the scan comes first.
 inline constexpr double kWidestSearchM = 20.0;
 inline constexpr double kWidestSearchDeg = 45.0;
 RegistrationConfig widened(RegistrationConfig config, const MoveUncertainty& prior);

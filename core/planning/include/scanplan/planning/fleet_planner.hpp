@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@ namespace scanplan {
 struct FleetRobot {
   std::string id;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  std::optional<DriveDrift> drift;  // PlanInput::drift
 };
 
 struct FleetPlan {

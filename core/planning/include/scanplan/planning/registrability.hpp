@@ -31,7 +31,30 @@ struct RegistrabilityConfig {
   // falls with the square of the range, and a wall next to the scanner is not infinitely
   // many points.
   double near_range_m = 3.0;
+  // With odometry that drifts (DriveDrift), a candidate a long drive away is reached with a
+  // pose 3σ of which may lie beyond the scan matcher's own search (PoseSearchConfig: ±6 m,
+  // ±30°). The match must then search wider, where a look-alike one building's depth away (16 m
+  // on the campus) fits as well, and is refused or wrong: on the campus with 2 % drift, scans
+  // after drives of 100–190 m were placed half as often as after shorter ones (issue 17). Such
+  // a candidate keeps the share s² of its F (at least floor_share), s = min(reach_xy_m / 3σ_xy,
+  // reach_yaw_deg / 3σ_yaw).
+  double reach_xy_m = 6.0;
+  double reach_yaw_deg = 30.0;
 };
+
+// How uncertain a robot's pose will be where it scans next with odometry that drifts with the
+// distance driven: the spread it has now (after its latest scan the map placed, the drive
+// since) and what each metre of the drive there adds.
+struct DriveDrift {
+  double start_xy_m = 0, start_yaw_deg = 0;
+  double xy_per_m = 0;       // σ of x-y per metre driven (PoseNoise::xy_drift_fraction)
+  double yaw_deg_per_m = 0;  // σ of the heading per metre driven
+};
+
+// The share s of RegistrabilityConfig::reach_xy_m: 1 when 3σ of the pose after driving
+// `travel_m` stays within the matcher's search; for a robot whose pose is beyond the search
+// already, the share after the drive over that before it.
+double drive_reach(const DriveDrift& drift, double travel_m, const RegistrabilityConfig& config);
 
 // The forecast for one candidate.
 struct Registrability {
@@ -42,6 +65,8 @@ struct Registrability {
   // per unit of weighted overlap (yaw as a moment over the walls' RMS range, as
   // AlignmentQuality::weakest_constraint does): near zero in a corridor or before one wall.
   double pose_fixing = 0;
+  // drive_reach for the drive there (1 without drifting odometry or when the search reaches).
+  double reach = 1;
   // The share of its score the candidate keeps (1: registrable).
   double factor = 1;
 };

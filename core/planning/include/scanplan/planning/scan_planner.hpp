@@ -123,6 +123,10 @@ struct PlanInput {
   // on the same cells: candidates are forecast against it (PlannerConfig::registrability).
   // Null: no forecast (matching off, or a tool with one map).
   const MlsMap* anchored = nullptr;
+  // With odometry that drifts: how uncertain the robot's pose is now and grows as it drives;
+  // candidates are forecast with the drive there (RegistrabilityConfig::reach_xy_m). Null: pose
+  // sensors that do not drift.
+  const DriveDrift* drift = nullptr;
 };
 
 struct Plan {

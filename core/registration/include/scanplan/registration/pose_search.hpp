@@ -36,7 +36,20 @@ struct PoseSearchConfig {
   // refused as ambiguous: a search wider than the spacing of a repeated structure (a row of
   // equal buildings, parked cars) finds the same fit shifted by one period.
   double ambiguity_ratio = 0;
+  // How far off the initial pose is likely to be (σ, from the odometry since the robot's last
+  // placed scan: ScanGraph::prior_uncertainty); 0: nothing known, every pose in the range
+  // equally likely. With it, peaks are ranked, and search-gicp's refinements chosen, by their
+  // score times the prior's density relative to its centre (prior_weight): a look-alike one
+  // building's depth away (16 m on the campus), which at coarse resolution may score a little
+  // better than the true pose 2 m from where the odometry put the robot, no longer comes first.
+  double prior_sigma_xy_m = 0;
+  double prior_sigma_yaw_deg = 0;
 };
+
+// exp(−½ (d² / σ_xy² + θ² / σ_yaw²)) for a pose d metres and θ off `initial` (each term only
+// with its σ set): 1 at the initial pose and without a prior.
+double prior_weight(const PoseSearchConfig& config, const Eigen::Isometry3d& initial,
+                    const Eigen::Isometry3d& pose);
 
 struct PoseHypothesis {
   Eigen::Isometry3d transform;  // maps source into target
