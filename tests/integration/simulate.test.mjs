@@ -54,8 +54,10 @@ test('simulate on the tree-row world', { timeout: 120000 }, () => {
           assert.ok(Math.abs(s.matched.z - s.match.prior.z) <= 1.0, JSON.stringify(s));
         }
         // What the plan that sent the robot there forecast of the match.
+        // On drifting odometry (the world's), with the drive's reach of the matcher's search.
         assert.ok(s.forecast === null || (s.forecast.overlap_share >= 0 &&
-          s.forecast.overlap_share <= 1 && s.forecast.factor > 0 && s.forecast.factor <= 1),
+          s.forecast.overlap_share <= 1 && s.forecast.factor > 0 && s.forecast.factor <= 1 &&
+          s.forecast.reach > 0 && s.forecast.reach <= 1),
         JSON.stringify(s.forecast));
       }
     });
