@@ -43,13 +43,13 @@ PointCloud levelled(PointCloud scan, const Pose& pose) {
 RegistrationConfig widened(RegistrationConfig config, const MoveUncertainty& prior) {
   config.search.prior_sigma_xy_m = prior.xy_m;
   config.search.prior_sigma_yaw_deg = prior.yaw_deg;
+  config.search.ambiguity_ratio = 0.8;
   const double xy = std::min(3 * prior.xy_m, kWidestSearchM);
   const double yaw = std::min(3 * prior.yaw_deg, kWidestSearchDeg);
   if (xy <= config.search.xy_range_m && yaw <= config.search.yaw_range_deg) return config;
   config.search.xy_range_m = std::max(config.search.xy_range_m, xy);
   config.search.yaw_range_deg = std::max(config.search.yaw_range_deg, yaw);
   config.search.hypotheses = std::max(config.search.hypotheses, 5);
-  config.search.ambiguity_ratio = 0.8;
   return config;
 }
 

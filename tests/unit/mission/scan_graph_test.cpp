@@ -36,7 +36,10 @@ TEST(ScanGraph, TheSearchWidensWithTheUncertaintyButNotWithoutBound) {
   const RegistrationConfig base;
   const RegistrationConfig same = widened(base, {1.0, 0.1, 3.0});
   EXPECT_EQ(same.search.xy_range_m, base.search.xy_range_m);
-  EXPECT_EQ(same.search.ambiguity_ratio, 0.0);
+  // Narrow or wide, the search knows the prior, and two fits alike under it refuse the match.
+  EXPECT_EQ(same.search.prior_sigma_xy_m, 1.0);
+  EXPECT_EQ(same.search.prior_sigma_yaw_deg, 3.0);
+  EXPECT_GT(same.search.ambiguity_ratio, 0.0);
 
   const RegistrationConfig wide = widened(base, {3.0, 0.1, 2.0});
   EXPECT_DOUBLE_EQ(wide.search.xy_range_m, 9.0);

@@ -74,5 +74,45 @@ TEST_F(PoseSearch, SearchThenGicpRecoversWhatGicpAloneCannotReach) {
   EXPECT_LT(e.degrees, 0.05);
 }
 
+// A row of equal posts every 6 m, of which the map holds those east of the scan's true
+// position only: shifted one post east, more of the scan lands on the map than where it truly
+// is, so the look-alike scores best. The odometry's prior (σ 1.5 m around the truth) puts it
+// back in second place.
+TEST(PoseSearchPrior, ALookAlikeFartherFromThePriorDoesNotComeFirst) {
+  const auto posts = [](int first, int last) {
+    PointCloud c;
+    for (int i = first; i <= last; ++i) {
+      for (float z = 0; z <= 2.0f; z += 0.1f) {
+        for (float dx = -0.2f; dx <= 0.2f; dx += 0.1f) {
+          for (float dy = -0.2f; dy <= 0.2f; dy += 0.1f) {
+            c.points.emplace_back(6.0f * static_cast<float>(i) + dx, 5.0f + dy, z);
+          }
+        }
+      }
+    }
+    return c;
+  };
+  const PointCloud map = posts(0, 20);   // x 0..120
+  const PointCloud scan = posts(-5, 5);  // the scan at x = 0 sees x -30..30
+  PoseSearchConfig c;
+  c.xy_range_m = 7;
+  c.yaw_range_deg = 3;
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
+  const std::vector<PoseHypothesis> flat = search_poses(map, scan, I, c);
+  ASSERT_FALSE(flat.empty());
+  EXPECT_NEAR(flat.front().transform.translation().x(), 6.0, 0.6) << "the look-alike first";
+  c.prior_sigma_xy_m = 1.5;
+  c.prior_sigma_yaw_deg = 3;
+  const std::vector<PoseHypothesis> known = search_poses(map, scan, I, c);
+  ASSERT_FALSE(known.empty());
+  EXPECT_LT(known.front().transform.translation().head<2>().norm(), 0.6);
+  // The weight itself: 1 at the prior, exp(-½ (d/σ)²) off it, nothing without a σ.
+  EXPECT_EQ(prior_weight(c, I, I), 1.0);
+  Eigen::Isometry3d off = I;
+  off.translate(Eigen::Vector3d(3.0, 0, 0));
+  EXPECT_NEAR(prior_weight(c, I, off), std::exp(-2.0), 1e-12);
+  EXPECT_EQ(prior_weight(PoseSearchConfig{}, I, off), 1.0);
+}
+
 }  // namespace
 }  // namespace scanplan
