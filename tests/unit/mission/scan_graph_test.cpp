@@ -60,8 +60,13 @@ TEST(ScanGraph, OdometryIsAsSureAsTheDriftModelSays) {
   const MoveUncertainty still = drifting.odometry_uncertainty({0.1, 0, 0, 0});
   EXPECT_GE(still.xy_m, 0.05) << "a robot that hardly moved still slips";
 
-  const ScanGraph fixes({}, PoseNoise{});  // absolute: two independent fixes
-  EXPECT_NEAR(fixes.odometry_uncertainty({20, 0, 0, 0}).xy_m, std::sqrt(2.0), 1e-9);
+  // Absolute: two independent fixes (σ 1 m, 5°), the move measured in the first one's frame,
+  // whose heading error swings it sideways by its length.
+  const ScanGraph fixes({}, PoseNoise{});
+  EXPECT_NEAR(fixes.odometry_uncertainty({0, 0, 0, 0}).xy_m, std::sqrt(2.0), 1e-9);
+  EXPECT_NEAR(fixes.odometry_uncertainty({20, 0, 0, 0}).xy_m,
+              std::sqrt(2.0 + std::pow(20 * 5 * M_PI / 180, 2)), 1e-9);
+  EXPECT_NEAR(fixes.odometry_uncertainty({20, 0, 0, 0}).yaw_deg, 5 * std::sqrt(2.0), 1e-9);
 }
 
 TEST(ScanGraph, APriorIsAsUnsureAsTheMovesSinceTheLastAnchoredScan) {
