@@ -19,12 +19,14 @@ PoseChange change(const Pose& a, const Pose& b) {
           std::abs(rad2deg(std::remainder(b.yaw - a.yaw, 2 * M_PI)))};
 }
 
-// `config` searching, and correcting, as far as the pose it starts from may be off
-// (ScanGraph's uncertainty). A correction beyond the pose sensors' usual reach, or one from a
-// pose that may be off by more, is not applied as it stands (unsure(); ScanGraph::add's
-// `tentative`): on the campus, applied at once, such corrections were right 11 times and wrong
-// twice, each time by one building's depth (16 m), and a scan placed inside a building ends the
-// mission. `correct_as_far` false keeps the sensors' own limit.
+// `config` searching as far as the pose it starts from may be off (ScanGraph's uncertainty), and
+// correcting as far as the widest search and GICP after it reach. A correction beyond the pose
+// sensors' usual reach, or one from a pose that may be off by more, is not applied as it stands
+// (unsure(); ScanGraph::add's `tentative`): on the campus, applied at once, such corrections
+// were right 11 times and wrong twice, each time by one building's depth (16 m), and a scan
+// placed inside a building ends the mission. Refused instead, a robot lost by more than its
+// odometry's 3σ stayed lost: its every match right, and every one refused (issue 17).
+// `correct_as_far` false keeps the sensors' own limit.
 MapMatchConfig widened(MapMatchConfig config, const MoveUncertainty& prior,
                        bool correct_as_far = true) {
   config.registration = widened(config.registration, prior);

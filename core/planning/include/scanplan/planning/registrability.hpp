@@ -36,8 +36,8 @@ struct RegistrabilityConfig {
   // ±30°). The match must then search wider, where a look-alike one building's depth away (16 m
   // on the campus) fits as well, and is refused or wrong: on the campus with 2 % drift, scans
   // after drives of 100–190 m were placed half as often as after shorter ones (issue 17). Such
-  // a candidate keeps the share s² of its F (at least floor_share), s = min(reach_xy_m / 3σ_xy,
-  // reach_yaw_deg / 3σ_yaw).
+  // a candidate keeps the share s² of its F (at least floor_share), s = drive_reach: min(reach_xy_m
+  // / 3σ_xy, reach_yaw_deg / 3σ_yaw) after the drive, over the same before it.
   double reach_xy_m = 6.0;
   double reach_yaw_deg = 30.0;
 };
