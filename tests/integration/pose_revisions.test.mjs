@@ -53,6 +53,11 @@ test('corrections are announced and recorded, and a restart resumes them', { tim
     assert.ok(c.revision >= 1, `recorded as a pose revision: ${JSON.stringify(c)}`);
     assert.ok(c.scans.length + c.joined.length + c.left.length > 0);
   }
+  // And in the mission's record, where a page that reloads reads its log back from.
+  const { decisions } = await (await stack.api('GET', '/api/v1/decisions')).json();
+  const recorded = decisions.filter((d) => d.kind === 'map_corrected');
+  assert.deepEqual(recorded.map((d) => d.revision), corrected.map((c) => c.revision));
+  assert.deepEqual(recorded.map((d) => d.joined), corrected.map((c) => c.joined));
   // map_updated and the scan list agree on which scans wait outside the map, and a waiting
   // scan's points are not in the map's.
   const waiting = before.scans.filter((s) => !s.in_map);
