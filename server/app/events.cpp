@@ -7,6 +7,7 @@
 
 #include "common/iso_time.hpp"
 #include "http/websocket_hub.hpp"
+#include "storage/session_store.hpp"
 
 namespace scanplan::server {
 
@@ -18,6 +19,16 @@ void Events::publish(const std::string& type, nlohmann::json data) const {
     hub_->broadcast_text(data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   } catch (const std::exception& e) {
     spdlog::warn("event '{}' not sent: {}", type, e.what());
+  }
+}
+
+void publish_recorded(const Events& events, SessionStore& session, const std::string& type,
+                      const nlohmann::json& details) {
+  events.publish(type, details);
+  try {
+    session.append_event(type, details.dump());
+  } catch (const std::exception& e) {
+    spdlog::error("could not record '{}' in the session: {}", type, e.what());
   }
 }
 

@@ -26,12 +26,7 @@ void Mission::record(const std::string& kind, json details) {
 }
 
 void Mission::record_event(const std::string& type, const json& details) {
-  events_.publish(type, details);
-  try {
-    session_.append_event(type, details.dump());
-  } catch (const std::exception& e) {
-    spdlog::error("could not record '{}' in the session: {}", type, e.what());
-  }
+  publish_recorded(events_, session_, type, details);
 }
 
 PlanBook::Found Mission::find(std::uint64_t id) const {

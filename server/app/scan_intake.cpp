@@ -218,14 +218,8 @@ void ScanIntake::record_correction(const MapCorrected& corrected) {
       "map corrected (revision {}): {} scans moved up to {:.3f} m / {:.2f}°, {} joined, {} left",
       revision, corrected.moved.size(), corrected.max_moved_m, corrected.max_turned_deg,
       corrected.joined.size(), corrected.left.size());
-  const nlohmann::json said = map_corrected_json(corrected, revision);
-  events_.publish("map_corrected", said);
   // In the mission's record too: the operator's log shows it after a reload or reconnection.
-  try {
-    session_.append_event("map_corrected", said.dump());
-  } catch (const SessionStoreError& failure) {
-    spdlog::error("could not record the map correction in the session: {}", failure.what());
-  }
+  publish_recorded(events_, session_, "map_corrected", map_corrected_json(corrected, revision));
 }
 
 void ScanIntake::resume_poses() {

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "scanplan/geometry/pose.hpp"
+
 namespace scanplan {
 
 RegistrabilityField::RegistrabilityField(const MlsMap& anchored, CellIndex origin, int cols,
@@ -115,7 +117,7 @@ namespace {
 // The share of 3σ of the pose after driving d metres that the search reaches.
 double reached(const DriveDrift& drift, double d, const RegistrabilityConfig& config) {
   // A heading already off swings the whole drive sideways.
-  const double swing = d * drift.start_yaw_deg * M_PI / 180;
+  const double swing = d * deg2rad(drift.start_yaw_deg);
   const double xy = std::sqrt(drift.start_xy_m * drift.start_xy_m +
                               std::pow(drift.xy_per_m * d, 2) + swing * swing);
   const double yaw = std::hypot(drift.start_yaw_deg, drift.yaw_deg_per_m * d);
