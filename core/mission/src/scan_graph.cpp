@@ -170,13 +170,13 @@ void ScanGraph::confirm_by_odometry(std::size_t k) {
   // odometry); the one after it, placed by its own match, does (its match started elsewhere).
   const std::size_t p = previous_[k];
   if (p != kNoNode && pending_map_[p] && pending_map_[k] &&
-      odometry_agrees(p, pending_map_[p]->placed, k, pending_map_[k]->placed)) {
+      odometry_agrees(p, placed_now(p, *pending_map_[p]), k, placed_now(k, *pending_map_[k]))) {
     believe_waiting(p);
     believe_waiting(k);
     return;
   }
   if (p != kNoNode && pending_map_[p] && anchored_[k] && !pending_map_[k] &&
-      odometry_agrees(p, pending_map_[p]->placed, k, graph_.pose(k))) {
+      odometry_agrees(p, placed_now(p, *pending_map_[p]), k, graph_.pose(k))) {
     believe_waiting(p);
   }
 }
@@ -184,12 +184,18 @@ void ScanGraph::confirm_by_odometry(std::size_t k) {
 void ScanGraph::believe_waiting(std::size_t scan) {
   const MapCandidate c = *pending_map_[scan];
   pending_map_[scan].reset();
-  add_match_to_map(scan, c.placed, c.information, "map-confirmed");
+  tie_to_map(scan, c, "map-confirmed");
 }
 
+// The match is kept against the anchored scan nearest to it as the map stood when it ran: the
+// match said where the scan lies relative to the map as it was, and by the time it is believed
+// the graph may have moved that part of the map (before, the edge took the reference's pose at
+// confirmation, and a move in between went into the edge as an error).
 void ScanGraph::offer_match_to_map(std::size_t scan, const Pose& placed,
                                    const Eigen::Matrix4d& information) {
-  pending_map_[scan] = MapCandidate{placed, information};
+  const auto reference = nearest_anchored(scan, placed);
+  if (!reference) return;
+  pending_map_[scan] = MapCandidate{placed, information, *reference, graph_.pose(*reference)};
   confirm_by_odometry(scan);
   // A re-match of an older scan: the robot's scan after it may already be in the map.
   for (std::size_t n = scan + 1; n < previous_.size() && pending_map_[scan]; ++n) {
@@ -217,6 +223,12 @@ void ScanGraph::add_odometry(std::size_t from, std::size_t to) {
 // had it.
 void ScanGraph::add_match_to_map(std::size_t k, const Pose& placed,
                                  const Eigen::Matrix4d& information, const char* origin) {
+  if (const auto reference = nearest_anchored(k, placed)) {
+    tie_to_map(k, {placed, information, *reference, graph_.pose(*reference)}, origin);
+  }
+}
+
+std::optional<std::size_t> ScanGraph::nearest_anchored(std::size_t k, const Pose& placed) const {
   std::optional<std::size_t> nearest;
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t j = 0; j < graph_.size(); ++j) {
@@ -225,16 +237,23 @@ void ScanGraph::add_match_to_map(std::size_t k, const Pose& placed,
     const double d = std::hypot(p.x - placed.x, p.y - placed.y);
     if (d < best) best = d, nearest = j;
   }
-  if (!nearest) return;
+  return nearest;
+}
+
+// Where a map match puts the scan now: the graph may have moved the map since the match.
+Pose ScanGraph::placed_now(std::size_t k, const MapCandidate& c) const {
+  const Pose& at = graph_.pose(k);
+  return compose(graph_.pose(c.reference), relative_pose(c.reference_pose, c.placed), at.roll,
+                 at.pitch);
+}
+
+void ScanGraph::tie_to_map(std::size_t k, const MapCandidate& c, const char* origin) {
+  graph_.set_pose(k, placed_now(k, c));  // a levelled match keeps the measured tilt
   anchored_[k] = 1;
   uncertain_[k] = MoveUncertainty{};
-  Pose at = placed;  // a levelled match keeps the measured tilt
-  at.roll = graph_.pose(k).roll;
-  at.pitch = graph_.pose(k).pitch;
-  graph_.set_pose(k, at);
-  const Pose& j = graph_.pose(*nearest);
-  add_match_edge({*nearest, k, relative_pose(j, placed),
-                  match_information(turned_information(information, j.yaw), config_.match_sigma_m),
+  add_match_edge({c.reference, k, relative_pose(c.reference_pose, c.placed),
+                  match_information(turned_information(c.information, c.reference_pose.yaw),
+                                    config_.match_sigma_m),
                   EdgeKind::kMatch},
                  origin, k);
   pending_[k].clear();

@@ -115,5 +115,24 @@ TEST(ScanGraph, AWaitingScanIsBelievedWhenTheNextScanIsPlacedWhereTheOdometrySay
   EXPECT_TRUE(graph.anchored(1));
 }
 
+// A waiting match said where the scan lies relative to the map as it was when the match ran; if
+// the graph moves that part of the map before the match is believed, the scan moves with it.
+TEST(ScanGraph, AWaitingMatchKeepsItsPlaceRelativeToTheMapItWasMatchedTo) {
+  ScanGraph graph({}, drift());
+  graph.add(few_points(), placement(at(0, 0, 0), at(0, 0, 0), false));
+  graph.add(few_points(), placement(at(100, 0, 0), at(100, 0, 0), true));
+  graph.add(few_points(), placement(at(150, 0, 0), at(150, 8, 0), true), /*tentative=*/true);
+  ASSERT_FALSE(graph.anchored(2));
+  // A later match pulls scan 1 (the one nearest the waiting match) half a metre sideways.
+  graph.add_match_to_map(1, at(100, 1, 0), Eigen::Matrix4d::Identity() * 0.3, "rematch");
+  graph.solve();
+  const double moved = graph.poses()[1].y;
+  ASSERT_GT(moved, 0.3);
+  graph.add(few_points(), placement(at(160, 0, 0), at(160, 8 + moved, 0), true));
+  ASSERT_TRUE(graph.anchored(2));
+  EXPECT_NEAR(graph.poses()[2].y - graph.poses()[1].y, 8.0, 0.05);
+  EXPECT_NEAR(graph.poses()[2].x - graph.poses()[1].x, 50.0, 0.05);
+}
+
 }  // namespace
 }  // namespace scanplan

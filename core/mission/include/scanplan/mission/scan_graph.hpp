@@ -162,6 +162,17 @@ class ScanGraph {
                        const Pose& b_placed) const;
   void confirm_by_odometry(std::size_t scan);
   void believe_waiting(std::size_t scan);
+  // A map match: where it placed the scan, and the anchored scan nearest to that (`reference`)
+  // where the map had it when the match ran.
+  struct MapCandidate {
+    Pose placed;
+    Eigen::Matrix4d information;
+    std::size_t reference;
+    Pose reference_pose;
+  };
+  std::optional<std::size_t> nearest_anchored(std::size_t scan, const Pose& placed) const;
+  Pose placed_now(std::size_t scan, const MapCandidate& match) const;
+  void tie_to_map(std::size_t scan, const MapCandidate& match, const char* origin);
   Pose implied(const GraphEdge& edge, std::size_t scan) const;
 
   ScanGraphConfig config_;
@@ -177,10 +188,6 @@ class ScanGraph {
   // Per scan not anchored: pairwise results with anchored scans waiting for one that agrees.
   std::vector<std::vector<GraphEdge>> pending_;
   // Per scan: a map match beyond the sensors' usual reach, waiting for the odometry to agree.
-  struct MapCandidate {
-    Pose placed;
-    Eigen::Matrix4d information;
-  };
   std::vector<std::optional<MapCandidate>> pending_map_;
   std::vector<std::size_t> previous_;  // per scan: the robot's scan before it, or kNoNode
   std::vector<std::string> tracks_;    // per scan
