@@ -385,7 +385,8 @@ test('a full disk refuses new scans with 503 and loses none it acknowledged', as
     server = start(0);
     url = await urlOf(server);
     let back;
-    for (let i = 0; i < 100; i++) {
+    // The restart rebuilds the map from every scan: seconds alone, more beside other tests.
+    for (let i = 0; i < 600; i++) {
       back = await (await call(url, 'GET', '/api/v1/session')).json();
       if (back.rebuilding === null && back.scans === acknowledged) break;
       await new Promise((r) => setTimeout(r, 100));

@@ -1,6 +1,7 @@
 #include "scanplan/experiments/closed_loop.hpp"
 
 #include <chrono>
+#include <optional>
 #include <random>
 #include <set>
 
@@ -69,11 +70,13 @@ std::optional<std::size_t> drive_to_best(const WorldTraversability& trav,
 }
 
 // The scan matched against the map and joined, the graph optimised: step's poses and match.
-void place(MissionPipeline& mission, const PointCloud& cloud, LoopStep& step) {
+void place(MissionPipeline& mission, const PointCloud& cloud, LoopStep& step,
+           const std::optional<Eigen::Vector3d>& goal) {
   step.prior_pose = mission.prior(step.reported_pose, kTrack);
   step.matched_pose = step.prior_pose;
   Placement where{step.reported_pose, step.prior_pose, false};
   where.track = kTrack;
+  where.goal = goal;
   if (const auto m = mission.place(cloud, step.reported_pose, kTrack)) {
     step.match = m->result;
     step.match_applied = m->applied;
@@ -238,6 +241,7 @@ LoopResult run_closed_loop(
   LoopResult result;
   SimulatedOdometry odometry(world.pose_noise, truth, config.seed);
   double path_m = 0;
+  std::optional<Eigen::Vector3d> goal;  // where the robot was last sent, on the map
   for (int scan = 1; scan <= config.max_scans; ++scan) {
     LoopStep step;
     step.scan = scan;
@@ -252,7 +256,7 @@ LoopResult run_closed_loop(
       ground = reachable_ground_cells(world, trav, start_reach, pipeline.map(), map_from_world);
       result.reachable_cells = ground.size();
     }
-    place(mission, cloud, step);
+    place(mission, cloud, step, goal);
     if (!result.steps.empty()) step_errors(result.steps.front(), step);
     const RegionMap& regions = *pipeline.regions();
     step.detected_m2 = regions.detected_m2();
@@ -280,6 +284,7 @@ LoopResult run_closed_loop(
       const double before = path_m;
       step.chosen = drive_to_best(trav, plan.ranked, world_from_map, truth, path_m);
       if (step.chosen) odometry.moved(truth, path_m - before);
+      if (step.chosen) goal = plan.ranked[*step.chosen].position;
     }
     if (on_step) on_step(step, pipeline);
     result.steps.push_back(std::move(step));

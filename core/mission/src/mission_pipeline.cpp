@@ -9,8 +9,6 @@ namespace {
 // A move smaller than this is not worth telling anyone about (the range noise is 1 cm).
 constexpr double kNoticeableM = 0.005;
 constexpr double kNoticeableDeg = 0.01;
-// The 99 % quantile of χ² with 3 degrees of freedom.
-constexpr double kChi2Of3Dof99 = 11.34;
 
 struct PoseChange {
   double metres = 0, degrees = 0;
@@ -44,20 +42,6 @@ PipelineConfig with_planner_thresholds(PipelineConfig mapping, const PlannerConf
   mapping.regions = planner.regions;
   mapping.movable = planner.movable;
   return mapping;
-}
-
-// Whether a re-match lands where the scan's estimate may be: within the 99 % ellipsoid of its
-// uncertainty in x, y and yaw (χ² with 3 degrees of freedom). A scan refused when it came was
-// placed by odometry no worse than that; a fit farther out, when the search found none nearer,
-// is a look-alike: on the campus, one spot refused at its true pose (5.8–6.9 % inliers) was
-// re-matched 4–5.5 m off (4σ) in four seeds of ten, and the map around it then followed.
-// Waiting for a confirmation did not help: a neighbour found the same look-alike (issue 17).
-bool within_prior(const Pose& estimate, const Pose& placed, const MoveUncertainty& u) {
-  if (u.xy_m <= 0 || u.yaw_deg <= 0) return true;  // no odometry prior to hold it to
-  const PoseChange d = change(estimate, placed);
-  const double chi2 =
-      (d.metres * d.metres) / (u.xy_m * u.xy_m) + (d.degrees * d.degrees) / (u.yaw_deg * u.yaw_deg);
-  return chi2 <= kChi2Of3Dof99;
 }
 
 }  // namespace
@@ -138,6 +122,7 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
   cloud_poses_.push_back(where.placed);
   anchored_near_.push_back(0);
   in_map_.push_back(0);
+  goals_.push_back(where.goal);
   if (!graph_) {
     join_map(scan, placed_.size() - 1);
     return;
@@ -246,7 +231,7 @@ bool MissionPipeline::rematch_refused(GraphUpdate& update) {
     const MapMatch m =
         match_to_map(points_near(at.x, at.y, radius, /*anchored_only=*/true), graph_->thinned(u),
                      level(at), widened(*config_.matching, graph_->uncertainty(u)));
-    if (!m.applied || !within_prior(at, m.placed, graph_->uncertainty(u))) continue;
+    if (!m.applied) continue;
     if (beyond_reach(graph_->uncertainty(u)) ||
         change(at, m.placed).metres > config_.matching->max_correction_m) {
       graph_->offer_match_to_map(u, m.placed, m.information);
@@ -357,11 +342,16 @@ std::optional<DriveDrift> MissionPipeline::drift_of(const std::string& track) co
 // Where the scans the map does not hold were taken, as the graph has them: the planner counts
 // what they saw as scanned and sends no robot right back there (a scan taken again where one
 // could not be placed would most likely fail the same way); a scan around them later ties them
-// in. Roughly placed, but metres matter little to that.
+// in. Roughly placed, but metres matter little to that; and where the robot was sent for it,
+// too: a lost robot's estimate lies tens of metres off, and without its goal claimed the same
+// candidate stayed the best, the robot scanning one spot for the rest of the mission (issue 17,
+// seed 1).
 std::vector<Eigen::Vector3d> MissionPipeline::unplaced_scan_points() const {
   std::vector<Eigen::Vector3d> out;
   for (std::size_t i = 0; i < poses_.size(); ++i) {
-    if (!in_map_[i]) out.emplace_back(poses_[i].x, poses_[i].y, poses_[i].z);
+    if (in_map_[i]) continue;
+    out.emplace_back(poses_[i].x, poses_[i].y, poses_[i].z);
+    if (goals_[i]) out.push_back(*goals_[i]);
   }
   return out;
 }

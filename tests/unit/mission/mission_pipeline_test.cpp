@@ -146,6 +146,23 @@ TEST_F(MissionPipelineTest, AScanNothingTiesInStaysOutOfTheMap) {
   EXPECT_EQ(mission.poses().size(), 2u);
 }
 
+// A lost robot's estimate lies far from where it was sent; the planner is told both, so that it
+// does not send the robot to the same candidate again and again.
+TEST_F(MissionPipelineTest, AScanOutsideTheMapIsClaimedWhereTheRobotWasSentToo) {
+  MissionPipeline mission(config());
+  mission.add(scan_at(at(-15, -8, 0), 1), {at(-15, -8, 0), at(-15, -8, 0)});
+  PointCloud few;  // too few points to match anything
+  for (int i = 0; i < 20; ++i) few.push_back({static_cast<float>(i), 3.0f, 0.0f}, {1, 2, 3});
+  Placement where{at(10, 5, 0), at(10, 5, 0)};
+  where.goal = Eigen::Vector3d(-2, 9, 0);
+  mission.add(few, where);
+  ASSERT_FALSE(mission.in_map(1));
+  const std::vector<Eigen::Vector3d> claimed = mission.unplaced_scan_points();
+  ASSERT_EQ(claimed.size(), 2u);
+  EXPECT_NEAR(claimed[0].x(), 10, 1e-6);
+  EXPECT_TRUE(claimed[1].isApprox(Eigen::Vector3d(-2, 9, 0)));
+}
+
 // With exact pose sensors (a total station, a simulation without noise) a scan no match places
 // joins the map where it is reported: the sensors alone place it within the map's accuracy.
 TEST_F(MissionPipelineTest, ExactSensorsPlaceAScanNoMatchPlaced) {

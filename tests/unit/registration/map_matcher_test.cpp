@@ -80,6 +80,28 @@ TEST_F(MapMatcher, ACorrectionLargerThanTheSensorsCanErrIsNotApplied) {
   EXPECT_EQ(m.placed.x, reported.x) << "a refused match leaves the reported pose";
 }
 
+// Told how far off the pose it starts from may be (the odometry's σ), the match refuses a fit
+// outside that prior's 99 % ellipsoid: where the odometry cannot be that wrong, it is a
+// look-alike. The same correction within the prior is applied.
+TEST_F(MapMatcher, AFitFarOutsideTheOdometrysPriorIsNotApplied) {
+  Pose reported = truth_;
+  reported.x += 2.0;
+  reported.y -= 1.0;
+  for (const double sigma_m : {0.4, 1.5}) {
+    MapMatchConfig c = quick();
+    c.registration.search.prior_sigma_xy_m = sigma_m;
+    c.registration.search.prior_sigma_yaw_deg = 2.0;
+    const MapMatch m = match_to_map(map_, scan_, reported, c);
+    if (sigma_m < 1) {  // 2.2 m is 5.6σ
+      EXPECT_FALSE(m.applied);
+      EXPECT_NE(m.result.message.find("look-alike"), std::string::npos) << m.result.message;
+    } else {  // 1.5σ
+      ASSERT_TRUE(m.applied) << m.result.message;
+      EXPECT_LT(metres_between(m.placed, truth_), 0.03);
+    }
+  }
+}
+
 // A refused match leaves x, y and yaw as reported, but the ground still fixes the height: a
 // scan left 0.4 m high would put a false step into the map.
 TEST_F(MapMatcher, ARefusedMatchIsStillSetOnTheGround) {

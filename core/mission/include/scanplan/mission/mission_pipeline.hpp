@@ -105,6 +105,9 @@ class MissionPipeline {
   // (nothing when the map placed that scan) and how it grows as the robot drives
   // (PlanInput::drift). Nothing otherwise, or before the track's first scan.
   std::optional<DriveDrift> drift_of(const std::string& track) const;
+  // What the planner counts as scanned although the map does not hold it: each scan outside the
+  // map, at the graph's estimate and where its robot was sent for it (Placement::goal).
+  std::vector<Eigen::Vector3d> unplaced_scan_points() const;
 
   // New planner parameters; the segmentation and the movable region follow their thresholds.
   void set_planner(const PlannerConfig& planner);
@@ -152,6 +155,7 @@ class MissionPipeline {
   std::vector<Pose> poses_;        // per scan: where it is (the graph's estimate)
   std::vector<Pose> cloud_poses_;  // per scan: the pose its placed_ points were put at
   std::vector<std::uint8_t> in_map_;
+  std::vector<std::optional<Eigen::Vector3d>> goals_;  // per scan: Placement::goal
   std::optional<ScanGraph> graph_;
   std::optional<MapCorrection> last_correction_;
   // Per scan: how many anchored scans lay near it when it was last matched to the map; it is
@@ -170,7 +174,6 @@ class MissionPipeline {
   bool rematch_refused(GraphUpdate& update);
   bool unsure(const Placement& where) const;
   bool beyond_reach(const MoveUncertainty& u) const;
-  std::vector<Eigen::Vector3d> unplaced_scan_points() const;
   void follow_graph();
   void join_map(const PointCloud& own, std::size_t i);
   PointCloud own_frame(std::size_t i) const;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 
 #include "scanplan/geometry/pose.hpp"
@@ -22,6 +23,10 @@ struct Placement {
   // Whose pose sensors reported it (the robot id): consecutive scans of one robot are related
   // by its odometry; scans of different robots are not.
   std::string track;
+  // Where the robot was sent on the map before this scan (the approved candidate), if it was:
+  // a scan that cannot be placed is claimed for the planner there as well as at its estimate,
+  // which for a lost robot lies tens of metres off (MissionPipeline::unplaced_scan_points).
+  std::optional<Eigen::Vector3d> goal;
 };
 
 }  // namespace scanplan
