@@ -283,8 +283,10 @@ LoopResult run_closed_loop(
       step.candidates = plan.ranked;
       const double before = path_m;
       step.chosen = drive_to_best(trav, plan.ranked, world_from_map, truth, path_m);
-      if (step.chosen) odometry.moved(truth, path_m - before);
-      if (step.chosen) goal = plan.ranked[*step.chosen].position;
+      if (step.chosen) {
+        odometry.moved(truth, path_m - before);
+        goal = plan.ranked[*step.chosen].position;
+      }
     }
     if (on_step) on_step(step, pipeline);
     result.steps.push_back(std::move(step));

@@ -193,9 +193,8 @@ void ScanGraph::believe_waiting(std::size_t scan) {
 // confirmation, and a move in between went into the edge as an error).
 void ScanGraph::offer_match_to_map(std::size_t scan, const Pose& placed,
                                    const Eigen::Matrix4d& information) {
-  const auto reference = nearest_anchored(scan, placed);
-  if (!reference) return;
-  pending_map_[scan] = MapCandidate{placed, information, *reference, graph_.pose(*reference)};
+  pending_map_[scan] = as_found(scan, placed, information);
+  if (!pending_map_[scan]) return;
   confirm_by_odometry(scan);
   // A re-match of an older scan: the robot's scan after it may already be in the map.
   for (std::size_t n = scan + 1; n < previous_.size() && pending_map_[scan]; ++n) {
@@ -223,12 +222,13 @@ void ScanGraph::add_odometry(std::size_t from, std::size_t to) {
 // had it.
 void ScanGraph::add_match_to_map(std::size_t k, const Pose& placed,
                                  const Eigen::Matrix4d& information, const char* origin) {
-  if (const auto reference = nearest_anchored(k, placed)) {
-    tie_to_map(k, {placed, information, *reference, graph_.pose(*reference)}, origin);
-  }
+  if (const auto match = as_found(k, placed, information)) tie_to_map(k, *match, origin);
 }
 
-std::optional<std::size_t> ScanGraph::nearest_anchored(std::size_t k, const Pose& placed) const {
+// A map match with the anchored scan nearest to where it placed the scan, as the graph has that
+// scan now; nothing while no scan is anchored.
+std::optional<ScanGraph::MapCandidate> ScanGraph::as_found(
+    std::size_t k, const Pose& placed, const Eigen::Matrix4d& information) const {
   std::optional<std::size_t> nearest;
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t j = 0; j < graph_.size(); ++j) {
@@ -237,7 +237,8 @@ std::optional<std::size_t> ScanGraph::nearest_anchored(std::size_t k, const Pose
     const double d = std::hypot(p.x - placed.x, p.y - placed.y);
     if (d < best) best = d, nearest = j;
   }
-  return nearest;
+  if (!nearest) return std::nullopt;
+  return MapCandidate{placed, information, *nearest, graph_.pose(*nearest)};
 }
 
 // Where a map match puts the scan now: the graph may have moved the map since the match.

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "scanplan/geometry/pose_information.hpp"
+#include "scanplan/registration/pose_search.hpp"
 
 namespace scanplan {
 namespace {
@@ -74,18 +75,19 @@ MapMatch match_to_map(const PointCloud& map_points, const PointCloud& scan, cons
   // the campus one spot refused at its true pose (5.8–8.6 % inliers) was matched 4–5.5 m off
   // (4–5σ) in five runs of ten, and the map around it followed (issue 17). Waiting for
   // confirmation did not help: a neighbour found the same look-alike.
-  const PoseSearchConfig& prior = config.registration.search;
+  PoseSearchConfig prior = config.registration.search;
   if (prior.prior_sigma_xy_m > 0 && prior.prior_sigma_yaw_deg > 0) {
-    const double d_xy = std::hypot(corrected.x - reported.x, corrected.y - reported.y);
-    const double sigma_m = std::max(prior.prior_sigma_xy_m, kGateFloorM);
-    const double sigma_deg = std::max(prior.prior_sigma_yaw_deg, kGateFloorDeg);
-    const double chi2 = std::pow(d_xy / sigma_m, 2) + std::pow(rad2deg(turn) / sigma_deg, 2);
+    prior.prior_sigma_xy_m = std::max(prior.prior_sigma_xy_m, kGateFloorM);
+    prior.prior_sigma_yaw_deg = std::max(prior.prior_sigma_yaw_deg, kGateFloorDeg);
+    // prior_weight is exp(−½ χ²).
+    const double chi2 = -2 * std::log(prior_weight(prior, initial, out.result.transform));
     if (chi2 > kChi2Of3Dof99) {
       char why[200];
       std::snprintf(why, sizeof why,
                     "the match moved the scan %.2f m and %.2f°, %.1fσ from where its odometry "
                     "puts it (σ %.2f m, %.2f°): a look-alike, not applied",
-                    d_xy, rad2deg(turn), std::sqrt(chi2), sigma_m, sigma_deg);
+                    std::hypot(corrected.x - reported.x, corrected.y - reported.y), rad2deg(turn),
+                    std::sqrt(chi2), prior.prior_sigma_xy_m, prior.prior_sigma_yaw_deg);
       out.result.converged = false;
       out.result.message = why;
       return refuse();

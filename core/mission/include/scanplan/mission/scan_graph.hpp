@@ -170,7 +170,8 @@ class ScanGraph {
     std::size_t reference;
     Pose reference_pose;
   };
-  std::optional<std::size_t> nearest_anchored(std::size_t scan, const Pose& placed) const;
+  std::optional<MapCandidate> as_found(std::size_t scan, const Pose& placed,
+                                       const Eigen::Matrix4d& information) const;
   Pose placed_now(std::size_t scan, const MapCandidate& match) const;
   void tie_to_map(std::size_t scan, const MapCandidate& match, const char* origin);
   Pose implied(const GraphEdge& edge, std::size_t scan) const;
