@@ -56,6 +56,8 @@ json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas, bool i
           {"points", s.points},
           {"estimated", pose_json(s.estimated)},
           {"placed", pose_json(s.placed)},
+          {"goal", s.goal ? json{{"x", s.goal->x()}, {"y", s.goal->y()}, {"z", s.goal->z()}}
+                          : json(nullptr)},
           {"received_at", s.received_at},
           {"match", match_json(s.match)},
           {"areas", areas ? areas_json(*areas) : json(nullptr)},

@@ -27,11 +27,12 @@ PoseChange change(const Pose& a, const Pose& b) {
 }
 
 // Where a stored scan joins the mission: its match (if believed) with the match's information,
-// on its robot's track.
+// on its robot's track, and where the robot was sent for it.
 Placement placement_of(const StoredScan& scan) {
   Placement where(scan.estimated, scan.placed, scan.match && scan.match->applied);
   if (scan.match) where.information = scan.match->information;
   where.track = scan.robot;
+  where.goal = scan.goal;
   return where;
 }
 

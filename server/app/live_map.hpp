@@ -81,6 +81,11 @@ class LiveMap {
 
   // Where the laser sits above a scan's origin (PipelineConfig::sensor_height_m).
   double sensor_height_m() const { return sensor_height_m_; }
+  // Where `robot` was sent for the scan it sends now, if it arrived at an approved candidate
+  // (PlanBook::take_reached_goal): stored with the scan.
+  std::optional<Eigen::Vector3d> take_reached_goal(const std::string& robot) {
+    return plans_.take_reached_goal(robot);
+  }
   ~LiveMap();
   LiveMap(const LiveMap&) = delete;
   LiveMap& operator=(const LiveMap&) = delete;

@@ -77,6 +77,11 @@ bool PlanBook::set_candidate_state(std::uint64_t id, CandidateState state,
       if (c.id != id) continue;
       c.state = state;
       c.note = note;
+      if (state == CandidateState::kReached) {
+        reached_[robot] = c.candidate.position;
+      } else if (state != CandidateState::kRejected) {
+        reached_.erase(robot);  // moving on, or stopped short of it
+      }
       return true;
     }
   }
@@ -100,6 +105,15 @@ std::map<std::string, Eigen::Vector3d> PlanBook::driving_goals() const {
     if (const CandidateRecord* goal = active_goal(plan)) goals[robot] = goal->candidate.position;
   }
   return goals;
+}
+
+std::optional<Eigen::Vector3d> PlanBook::take_reached_goal(const std::string& robot) {
+  std::lock_guard lock(mutex_);
+  const auto it = reached_.find(robot);
+  if (it == reached_.end()) return std::nullopt;
+  const Eigen::Vector3d goal = it->second;
+  reached_.erase(it);
+  return goal;
 }
 
 std::vector<Eigen::Vector3d> PlanBook::claims_except(const std::string& robot) const {

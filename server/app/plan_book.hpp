@@ -70,13 +70,19 @@ class PlanBook {
 
   // The goals robots are driving to (an approved move under way), by robot.
   std::map<std::string, Eigen::Vector3d> driving_goals() const;
+  // Where `robot` arrived after an approved move (its candidate reached), once: the next scan
+  // it sends was taken there (StoredScan::goal). A new approval, a refusal, a cancellation or an
+  // interruption of that robot's move forgets it, so a scan after those is not claimed at a
+  // place never reached.
+  std::optional<Eigen::Vector3d> take_reached_goal(const std::string& robot);
   // Where the robots other than `robot` are going to scan next: the goals of approved moves,
   // else the best candidates of their plans.
   std::vector<Eigen::Vector3d> claims_except(const std::string& robot) const;
 
  private:
   mutable std::mutex mutex_;
-  std::map<std::string, PlanRecord> plans_;  // by robot
+  std::map<std::string, PlanRecord> plans_;         // by robot
+  std::map<std::string, Eigen::Vector3d> reached_;  // by robot: take_reached_goal
   std::string latest_robot_;
   std::atomic<std::uint64_t> next_plan_id_{1}, next_candidate_id_{1};
 };

@@ -118,7 +118,8 @@ SubmittedScan ScanIntake::submit(const std::string& robot, const Pose& estimated
         robot, dropped.non_finite, dropped.out_of_range, dropped.mount, dropped.saturated);
   }
   // Matching will correct `placed`; until then the reported pose is the best there is.
-  StoredScan stored = session_.add_scan(robot, estimated, estimated, stamp_ns, cloud);
+  StoredScan stored = session_.add_scan(robot, estimated, estimated, stamp_ns, cloud,
+                                        live_.take_reached_goal(robot));
   {
     std::lock_guard lock(mutex_);
     queue_.push_back({stored, std::move(cloud)});

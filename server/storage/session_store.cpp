@@ -109,7 +109,9 @@ constexpr const char* kScanColumns =
 const std::string kScanSelect =
     std::string("SELECT ") + kScanColumns +
     ", applied, converged, method, matches.reason, time_ms, inlier_ratio, "
-    "ex.excluded, ex.actor, ex.reason, ex.at, matches.information FROM scans LEFT JOIN matches "
+    "ex.excluded, ex.actor, ex.reason, ex.at, matches.information, goal_x, goal_y, goal_z FROM "
+    "scans "
+    "LEFT JOIN matches "
     "ON matches.scan_id = scans.id LEFT JOIN (SELECT scan_id, excluded, actor, reason, at FROM "
     "exclusions WHERE id IN (SELECT MAX(id) FROM exclusions GROUP BY scan_id)) ex "
     "ON ex.scan_id = scans.id";
@@ -158,6 +160,8 @@ StoredScan scan_from_row(const Statement& s) {
   }
   if (!s.null(24) && s.integer(24) != 0) r.excluded = Exclusion{s.text(25), s.text(26), s.text(27)};
   if (r.match && !s.null(28)) r.match->information = information_from_text(s.text(28));
+  if (!s.null(29) && !s.null(30) && !s.null(31))
+    r.goal = Eigen::Vector3d(s.real(29), s.real(30), s.real(31));
   return r;
 }
 
@@ -253,6 +257,11 @@ SessionStore::SessionStore(std::filesystem::path dir) : dir_(created(std::move(d
   // Sessions recorded before the pose graph have no information column.
   if (!has_column("matches", "information"))
     exec("ALTER TABLE matches ADD COLUMN information TEXT");
+  // Nor where the robot was sent for each scan (NULL: it was not, or not known).
+  for (const char* column : {"goal_x", "goal_y", "goal_z"}) {
+    if (!has_column("scans", column))
+      exec((std::string("ALTER TABLE scans ADD COLUMN ") + column + " REAL").c_str());
+  }
   // Every pose the graph gave a scan, by revision: the session's history of corrections.
   exec(
       "CREATE TABLE IF NOT EXISTS pose_revisions(revision INTEGER NOT NULL, scan_id INTEGER NOT "
@@ -337,7 +346,8 @@ void SessionStore::tidy_scan_files() const {
 
 StoredScan SessionStore::add_scan(const std::string& robot, const Pose& estimated,
                                   const Pose& placed, std::int64_t stamp_ns,
-                                  const PointCloud& cloud) {
+                                  const PointCloud& cloud,
+                                  const std::optional<Eigen::Vector3d>& goal) {
   std::lock_guard lock(mutex_);
   exec("BEGIN IMMEDIATE");
   try {
@@ -356,10 +366,12 @@ StoredScan SessionStore::add_scan(const std::string& robot, const Pose& estimate
     r.points = cloud.size();
     r.file = name;
     r.received_at = utc_now();
+    r.goal = goal;
     write_durably(dir_ / r.file, write_ply_bytes(cloud, {"scanplan robot " + robot}));
-    Statement ins(db_, (std::string("INSERT INTO scans(") + kScanColumns +
-                        ") VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)")
-                           .c_str());
+    Statement ins(db_,
+                  (std::string("INSERT INTO scans(") + kScanColumns +
+                   ", goal_x, goal_y, goal_z) VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)")
+                      .c_str());
     const Pose& e = estimated;
     const Pose& p = placed;
     ins.bind(1, r.id).bind(2, robot);
@@ -367,6 +379,7 @@ StoredScan SessionStore::add_scan(const std::string& robot, const Pose& estimate
     ins.bind(9, p.x).bind(10, p.y).bind(11, p.z).bind(12, p.roll).bind(13, p.pitch).bind(14, p.yaw);
     ins.bind(15, stamp_ns).bind(16, static_cast<std::int64_t>(r.points)).bind(17, r.file);
     ins.bind(18, r.received_at);
+    if (goal) ins.bind(19, goal->x()).bind(20, goal->y()).bind(21, goal->z());
     ins.step();
     exec("COMMIT");
     return r;

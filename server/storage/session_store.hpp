@@ -64,6 +64,9 @@ struct StoredScan {
   std::string received_at;            // UTC, ISO 8601
   std::optional<StoredMatch> match;   // none for the first scan, with matching off, or not yet
   std::optional<Exclusion> excluded;  // set while the operator keeps it out of the map
+  // Where the robot was sent for this scan (the approved candidate it reached, map frame): a
+  // scan the map cannot place is claimed for the planner there (Placement::goal).
+  std::optional<Eigen::Vector3d> goal;
 };
 
 // One row of the session's record of what happened (append_event).
@@ -110,9 +113,11 @@ class SessionStore {
 
   const std::filesystem::path& dir() const { return dir_; }
 
-  // `cloud` in the scan's own frame. Returns the new scan with its id.
+  // `cloud` in the scan's own frame; `goal` where the robot was sent for it, if it was. Returns
+  // the new scan with its id.
   StoredScan add_scan(const std::string& robot, const Pose& estimated, const Pose& placed,
-                      std::int64_t stamp_ns, const PointCloud& cloud);
+                      std::int64_t stamp_ns, const PointCloud& cloud,
+                      const std::optional<Eigen::Vector3d>& goal = std::nullopt);
   // Records how matching went for scan `id` and where the scan was placed (the match's
   // correction, or the reported pose carried into the map frame when it was refused): both in
   // one transaction.

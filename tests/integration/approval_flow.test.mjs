@@ -61,6 +61,11 @@ test('an approval drives the robot there and a scan follows its arrival', async 
   const session = await scanAndWaitWithoutAsking(2);
   const p = session.last_scan.pose;
   assert.ok(Math.hypot(p.x - first.x, p.y - first.y) < 0.01, `scanned at ${JSON.stringify(p)}`);
+  // The scan keeps where it was taken for: a scan the map cannot place is claimed there.
+  const scans = (await (await stack.api('GET', '/api/v1/scans')).json()).scans;
+  assert.equal(scans[0].goal, null, 'the first scan was not sent for');
+  const sentFor = scans.find((s) => s.id === 2).goal;
+  assert.deepEqual([sentFor.x, sentFor.y, sentFor.z], [first.x, first.y, first.z]);
   const after = await stack.waitFor('a new plan', async () => {
     const c = await candidates();
     return c.plan.based_on_scan === 2 ? c : undefined;

@@ -58,6 +58,30 @@ TEST(PlanBook, ClaimsAreTheOtherRobotsGoalsElseTheirBestCandidates) {
   EXPECT_TRUE(book.claims_except("b").size() == 1 && book.claims_except("b")[0].x() == 0);
 }
 
+// The scan a robot sends after arriving was taken where it was sent (StoredScan::goal), once; a
+// move that ended short of its goal leaves nothing to claim.
+TEST(PlanBook, ARobotThatReachedItsGoalWasSentThereForItsNextScanOnly) {
+  PlanBook book;
+  book.replace({{1, 1, "a", "paper", 0.5, 1, {at(1, 1, 10), at(2, 2, 20), at(3, 3, 30)}}}, "a");
+  EXPECT_FALSE(book.take_reached_goal("a")) << "not sent anywhere yet";
+  book.set_candidate_state(1, CandidateState::kMoving);
+  EXPECT_FALSE(book.take_reached_goal("a")) << "still driving";
+  book.set_candidate_state(1, CandidateState::kReached);
+  book.set_candidate_state(2, CandidateState::kRejected, "not there");
+  const auto goal = book.take_reached_goal("a");
+  ASSERT_TRUE(goal) << "a rejection of another candidate does not forget the arrival";
+  EXPECT_EQ(goal->x(), 10);
+  EXPECT_FALSE(book.take_reached_goal("a")) << "taken by the scan made there";
+  EXPECT_FALSE(book.take_reached_goal("b"));
+  for (const CandidateState stop :
+       {CandidateState::kRefused, CandidateState::kCancelled, CandidateState::kInterrupted}) {
+    book.set_candidate_state(1, CandidateState::kReached);
+    book.set_candidate_state(3, CandidateState::kMoving);
+    book.set_candidate_state(3, stop);
+    EXPECT_FALSE(book.take_reached_goal("a")) << to_string(stop) << ": it never got to 30";
+  }
+}
+
 TEST(PlanBook, IdsAreUniqueAcrossPlans) {
   PlanBook book;
   EXPECT_EQ(book.new_plan_id(), 1u);

@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
 #include <cmath>
 #include <fstream>
@@ -38,7 +39,8 @@ TEST_F(SessionDir, ScansSurviveReopeningWithPosesAndPoints) {
   {
     SessionStore s(dir_);
     EXPECT_EQ(s.add_scan("robot1", est, placed, 42, cloud_of(10, 0)).id, 1);
-    EXPECT_EQ(s.add_scan("robot2", est, placed, 43, cloud_of(5, 100)).id, 2);
+    EXPECT_EQ(s.add_scan("robot2", est, placed, 43, cloud_of(5, 100), Eigen::Vector3d(7, 8, 9)).id,
+              2);
     s.append_event("approval", R"({"candidate":1,"by":"operator"})");
   }
   SessionStore s(dir_);
@@ -49,6 +51,9 @@ TEST_F(SessionDir, ScansSurviveReopeningWithPosesAndPoints) {
   EXPECT_DOUBLE_EQ(scans[0].placed.x, 1.2);
   EXPECT_DOUBLE_EQ(scans[0].estimated.yaw, 0.5);
   EXPECT_EQ(scans[0].stamp_ns, 42);
+  EXPECT_FALSE(scans[0].goal) << "robot1 was not sent anywhere";
+  ASSERT_TRUE(scans[1].goal);
+  EXPECT_EQ(*scans[1].goal, Eigen::Vector3d(7, 8, 9));
   const PointCloud back = s.load_points(scans[1]);
   ASSERT_EQ(back.size(), 5u);
   EXPECT_EQ(back.points[4], Eigen::Vector3f(104, 8, 0.5f));
@@ -122,6 +127,37 @@ TEST_F(SessionDir, MatchInformationAndPoseRevisionsSurviveReopening) {
   EXPECT_DOUBLE_EQ(latest[1].pose.x, 2.53);
   EXPECT_DOUBLE_EQ(latest[1].pose.yaw, 0.1);
   EXPECT_TRUE(latest[1].in_map);
+}
+
+// A session recorded before the pose graph and the goals (no information, no goal columns) opens
+// with its scans as they were and takes new scans with their goals.
+TEST_F(SessionDir, ASessionFromBeforeTheGraphOpensAndGainsTheNewColumns) {
+  std::filesystem::create_directories(dir_ / "scans");
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((dir_ / "session.sqlite").c_str(), &db), SQLITE_OK);
+  const char* old_schema =
+      "CREATE TABLE scans(id INTEGER PRIMARY KEY, robot TEXT NOT NULL, est_x REAL, est_y REAL, "
+      "est_z REAL, est_roll REAL, est_pitch REAL, est_yaw REAL, x REAL, y REAL, z REAL, roll REAL, "
+      "pitch REAL, yaw REAL, stamp_ns INTEGER, points INTEGER, file TEXT NOT NULL, received_at "
+      "TEXT NOT NULL);"
+      "CREATE TABLE matches(scan_id INTEGER PRIMARY KEY REFERENCES scans(id), applied INTEGER NOT "
+      "NULL, converged INTEGER NOT NULL, method TEXT NOT NULL, reason TEXT NOT NULL, time_ms REAL "
+      "NOT NULL, inlier_ratio REAL NOT NULL);"
+      "INSERT INTO scans VALUES(1, 'r', 1, 2, 0, 0, 0, 0.5, 1.1, 2.1, 0, 0, 0, 0.49, 7, 10, "
+      "'scans/scan_000001.ply', '2026-12-01T00:00:00Z');"
+      "INSERT INTO matches VALUES(1, 1, 1, 'search-gicp', '', 40, 0.3);";
+  char* error = nullptr;
+  ASSERT_EQ(sqlite3_exec(db, old_schema, nullptr, nullptr, &error), SQLITE_OK) << error;
+  sqlite3_close(db);
+  SessionStore s(dir_);
+  const auto old = s.scan(1);
+  ASSERT_TRUE(old && old->match);
+  EXPECT_DOUBLE_EQ(old->placed.x, 1.1);
+  EXPECT_EQ(old->match->information, Eigen::Matrix4d::Zero()) << "not recorded then";
+  EXPECT_FALSE(old->goal);
+  Pose est;
+  EXPECT_EQ(s.add_scan("r", est, est, 8, cloud_of(10, 0), Eigen::Vector3d(3, 4, 5)).id, 2);
+  EXPECT_EQ(*s.scan(2)->goal, Eigen::Vector3d(3, 4, 5));
 }
 
 TEST_F(SessionDir, EventsReadBackNewestLimitOldestFirst) {
