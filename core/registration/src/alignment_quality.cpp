@@ -32,8 +32,10 @@ double median_of(std::vector<double>& v) {
 
 }  // namespace
 
-AlignmentJudge::AlignmentJudge(const PointCloud& target)
-    : target_(target), tree_(std::make_unique<detail::PointKdTree>(target.points)) {}
+AlignmentJudge::AlignmentJudge(const PointCloud& target, const detail::PointKdTree* tree)
+    : target_(target),
+      own_tree_(tree ? nullptr : std::make_unique<detail::PointKdTree>(target.points)),
+      tree_(tree ? tree : own_tree_.get()) {}
 
 AlignmentJudge::~AlignmentJudge() = default;
 

@@ -133,6 +133,13 @@ GicpMatcher::GicpMatcher(const PointCloud& target, const PointCloud& source,
 
 GicpMatcher::~GicpMatcher() = default;
 
+const detail::PointKdTree* GicpMatcher::unthinned_target_tree() const {
+  for (const auto& stage : stages_) {
+    if (!(stage->lengths.voxel_m > 0)) return &stage->target.tree();
+  }
+  return nullptr;
+}
+
 RegistrationResult GicpMatcher::align(const Eigen::Isometry3d& initial, Dof dof) const {
   return detail::with_dof(dof, [&]<int N>() {
     RegistrationResult r;

@@ -77,15 +77,28 @@ class LikelihoodGrid {
             static_cast<int>(std::floor(f.z()))};
   }
 
-  // Sum of the likelihoods of `cubes`, each shifted by (dx, dy) cubes; 0 outside the grid.
-  std::uint32_t score(const std::vector<Eigen::Vector3i>& cubes, int dx, int dy) const {
-    std::uint32_t sum = 0;
+  // The sums of the likelihoods of `cubes` shifted by every (dx0 + i, dy0 + j) cubes, |i|, |j| ≤
+  // steps, row by row (j, then i); 0 outside the grid. Each cube meets one run of the grid along
+  // x per row of shifts, so the shifts are summed from contiguous memory: the search is one
+  // sweep of a window per cube instead of a scattered read per cube and shift.
+  void score_window(const std::vector<Eigen::Vector3i>& cubes, int dx0, int dy0, int steps,
+                    std::vector<std::uint32_t>& sums) const {
+    const int w = 2 * steps + 1;
+    sums.assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(w), 0);
     for (const auto& c : cubes) {
-      const int x = c.x() + dx, y = c.y() + dy, z = c.z();
-      if (x < 0 || y < 0 || z < 0 || x >= nx_ || y >= ny_ || z >= nz_) continue;
-      sum += value_[index(x, y, z)];
+      const int z = c.z();
+      if (z < 0 || z >= nz_) continue;
+      const int x0 = c.x() + dx0 - steps;  // the x the first shift of a row reads
+      const int i0 = std::max(0, -x0), i1 = std::min(w, nx_ - x0);
+      if (i0 >= i1) continue;
+      for (int j = 0; j < w; ++j) {
+        const int y = c.y() + dy0 - steps + j;
+        if (y < 0 || y >= ny_) continue;
+        const std::uint8_t* row = &value_[index(0, y, z)];
+        std::uint32_t* out = &sums[static_cast<std::size_t>(j) * static_cast<std::size_t>(w)];
+        for (int i = i0; i < i1; ++i) out[i] += row[x0 + i];
+      }
     }
-    return sum;
   }
 
  private:
@@ -115,22 +128,25 @@ double offset_weight(const PoseSearchConfig& c, double metres, double radians) {
 }
 
 // The best of `found` that lie apart from each other, best first (by score times the prior).
-std::vector<Candidate> distinct_peaks(std::vector<Candidate> found, std::size_t count,
+std::vector<Candidate> distinct_peaks(const std::vector<Candidate>& found, std::size_t count,
                                       const PoseSearchConfig& config) {
   const double min_m = config.min_separation_m, min_rad = deg2rad(config.min_separation_deg);
-  const auto ranked = [&](const Candidate& a) {
-    return a.score * offset_weight(config, std::hypot(a.dx, a.dy), a.yaw);
-  };
-  std::sort(found.begin(), found.end(),
-            [&](const Candidate& a, const Candidate& b) { return ranked(a) > ranked(b); });
+  // Each candidate's rank once (thousands of them, an exp each), not once per comparison.
+  std::vector<std::pair<double, const Candidate*>> ranked;
+  ranked.reserve(found.size());
+  for (const Candidate& c : found) {
+    ranked.emplace_back(c.score * offset_weight(config, std::hypot(c.dx, c.dy), c.yaw), &c);
+  }
+  std::sort(ranked.begin(), ranked.end(),
+            [](const auto& a, const auto& b) { return a.first > b.first; });
   std::vector<Candidate> out;
-  for (const auto& c : found) {
+  for (const auto& [rank, c] : ranked) {
     if (out.size() >= count) break;
     const bool separate = std::all_of(out.begin(), out.end(), [&](const Candidate& o) {
-      return std::hypot(c.dx - o.dx, c.dy - o.dy) >= min_m ||
-             std::abs(std::remainder(c.yaw - o.yaw, 2 * M_PI)) >= min_rad;
+      return std::hypot(c->dx - o.dx, c->dy - o.dy) >= min_m ||
+             std::abs(std::remainder(c->yaw - o.yaw, 2 * M_PI)) >= min_rad;
     });
-    if (separate) out.push_back(c);
+    if (separate) out.push_back(*c);
   }
   return out;
 }
@@ -151,13 +167,15 @@ std::vector<Eigen::Vector3i> turned_cubes(const std::vector<Eigen::Vector3f>& pl
 // Every shift within ±steps cubes at each of `yaws`, around (dx0, dy0) cubes.
 void scan_window(const LikelihoodGrid& grid, const std::vector<Eigen::Vector3f>& placed,
                  const Eigen::Vector3f& centre, const std::vector<double>& yaws, int dx0, int dy0,
-                 int steps, int stride, std::vector<Candidate>& out) {
+                 int steps, std::vector<Candidate>& out) {
   const double n = static_cast<double>(std::max<std::size_t>(placed.size(), 1)) * 255.0;
+  const int w = 2 * steps + 1;
+  std::vector<std::uint32_t> sums;
   for (const double yaw : yaws) {
-    const std::vector<Eigen::Vector3i> cubes = turned_cubes(placed, centre, yaw, grid);
-    for (int j = -steps; j <= steps; j += stride) {
-      for (int i = -steps; i <= steps; i += stride) {
-        const double s = grid.score(cubes, dx0 + i, dy0 + j) / n;
+    grid.score_window(turned_cubes(placed, centre, yaw, grid), dx0, dy0, steps, sums);
+    for (int j = -steps; j <= steps; ++j) {
+      for (int i = -steps; i <= steps; ++i) {
+        const double s = sums[static_cast<std::size_t>((j + steps) * w + i + steps)] / n;
         out.push_back({(dx0 + i) * static_cast<double>(grid.cell()),
                        (dy0 + j) * static_cast<double>(grid.cell()), yaw, s});
       }
@@ -207,21 +225,21 @@ std::vector<PoseHypothesis> search_poses(const PointCloud& target, const PointCl
   std::vector<Candidate> found;
   const int reach = static_cast<int>(std::ceil(config.xy_range_m / coarse.cell()));
   scan_window(coarse, placed, centre, yaw_steps(0, deg2rad(config.yaw_range_deg), 2 * step), 0, 0,
-              reach, 1, found);
-  const std::vector<Candidate> rough = distinct_peaks(std::move(found), 3 * wanted, config);
+              reach, found);
+  const std::vector<Candidate> rough = distinct_peaks(found, 3 * wanted, config);
 
   std::vector<Candidate> refined;
   for (const Candidate& c : rough) {
     std::vector<Candidate> local;
     const int cx = static_cast<int>(std::lround(c.dx / fine.cell()));
     const int cy = static_cast<int>(std::lround(c.dy / fine.cell()));
-    scan_window(fine, placed, centre, yaw_steps(c.yaw, 2 * step, step), cx, cy, 2, 1, local);
+    scan_window(fine, placed, centre, yaw_steps(c.yaw, 2 * step, step), cx, cy, 2, local);
     refined.push_back(*std::max_element(
         local.begin(), local.end(),
         [](const Candidate& a, const Candidate& b) { return a.score < b.score; }));
   }
   std::vector<PoseHypothesis> out;
-  for (const Candidate& c : distinct_peaks(std::move(refined), wanted, config)) {
+  for (const Candidate& c : distinct_peaks(refined, wanted, config)) {
     Eigen::Isometry3d move = Eigen::Isometry3d::Identity();
     const Eigen::Vector3d pivot = centre.cast<double>();
     move.translate(pivot + Eigen::Vector3d(c.dx, c.dy, 0));

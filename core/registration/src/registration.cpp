@@ -116,7 +116,7 @@ RegistrationResult align_search_gicp(const PointCloud& target, const PointCloud&
                                      const Eigen::Isometry3d& initial,
                                      const RegistrationConfig& c) {
   const GicpMatcher gicp(target, source, c.gicp);
-  const AlignmentJudge judge(target);
+  const AlignmentJudge judge(target, gicp.unthinned_target_tree());
   // Which result to keep is judged on every third source point, a third of the cost; the kept
   // one is judged again on all of them (register_with).
   PointCloud sample;

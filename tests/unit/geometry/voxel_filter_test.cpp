@@ -1,7 +1,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <random>
 #include <stdexcept>
+#include <tuple>
+#include <vector>
 
 #include "scanplan/geometry/voxel_filter.hpp"
 
@@ -74,6 +80,54 @@ TEST(VoxelMap, RefusesAVoxelSizeThatIsNotPositive) {
   EXPECT_THROW(VoxelMap(0), std::invalid_argument);
   EXPECT_THROW(VoxelMap(-1), std::invalid_argument);
   EXPECT_THROW(VoxelMap(std::nan("")), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace scanplan
+
+namespace scanplan {
+namespace {
+
+// What voxel_downsample promises, computed the slow way: per voxel (z, then y, then x ascending)
+// the point nearest its points' centroid, the first of equals.
+std::vector<Eigen::Vector3f> thinned_by_definition(const PointCloud& cloud, double voxel_m) {
+  std::map<std::tuple<std::int64_t, std::int64_t, std::int64_t>, std::vector<std::size_t>> voxels;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3f& p = cloud.points[i];
+    if (!p.allFinite()) continue;
+    const auto cell = [&](int a) { return static_cast<std::int64_t>(std::floor(p[a] / voxel_m)); };
+    voxels[{cell(2), cell(1), cell(0)}].push_back(i);
+  }
+  std::vector<Eigen::Vector3f> out;
+  for (const auto& [key, members] : voxels) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const std::size_t i : members) sum += cloud.points[i].cast<double>();
+    const Eigen::Vector3d centroid = sum / static_cast<double>(members.size());
+    std::size_t best = members.front();
+    double best_sq = std::numeric_limits<double>::max();
+    for (const std::size_t i : members) {
+      const double d = (cloud.points[i].cast<double>() - centroid).squaredNorm();
+      if (d < best_sq) best_sq = d, best = i;
+    }
+    out.push_back(cloud.points[best]);
+  }
+  return out;
+}
+
+TEST(VoxelDownsample, KeepsThePointNearestEachVoxelsCentroidInVoxelOrder) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> coordinate(-60.0f, 60.0f);
+  PointCloud cloud;
+  for (int i = 0; i < 50000; ++i) {
+    const Eigen::Vector3f p(coordinate(rng), coordinate(rng), 0.05f * coordinate(rng));
+    cloud.push_back(p, {});
+    if (i % 7 == 0) cloud.push_back(p, {});  // equal points: the first is kept
+  }
+  cloud.push_back(Eigen::Vector3f(std::nanf(""), 0, 0), {});
+  for (const double voxel : {0.25, 1.0, 3.0}) {
+    const std::vector<Eigen::Vector3f> expected = thinned_by_definition(cloud, voxel);
+    EXPECT_EQ(voxel_downsample(cloud, voxel).points, expected) << voxel << " m voxels";
+  }
 }
 
 }  // namespace

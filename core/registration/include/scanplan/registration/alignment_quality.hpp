@@ -49,10 +49,12 @@ class PointKdTree;
 }
 
 // evaluate_alignment with the target's k-d tree built once, for judging several results
-// against the same target (search-gicp's hypotheses). Keeps a reference to `target`.
+// against the same target (search-gicp's hypotheses). Keeps a reference to `target`, and to
+// `tree` when given: one already built over exactly target's points, in their order (GICP's
+// over the unthinned target, GicpMatcher::unthinned_target_tree), which must outlive the judge.
 class AlignmentJudge {
  public:
-  explicit AlignmentJudge(const PointCloud& target);
+  explicit AlignmentJudge(const PointCloud& target, const detail::PointKdTree* tree = nullptr);
   ~AlignmentJudge();
   AlignmentJudge(const AlignmentJudge&) = delete;
   AlignmentJudge& operator=(const AlignmentJudge&) = delete;
@@ -63,7 +65,8 @@ class AlignmentJudge {
 
  private:
   const PointCloud& target_;
-  std::unique_ptr<detail::PointKdTree> tree_;
+  std::unique_ptr<detail::PointKdTree> own_tree_;
+  const detail::PointKdTree* tree_;
 };
 
 // Scores `source` moved by `source_to_target` against `target`. The paper does not say how

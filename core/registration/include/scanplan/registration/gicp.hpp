@@ -9,6 +9,10 @@
 
 namespace scanplan {
 
+namespace detail {
+class PointKdTree;
+}
+
 // One pass of GICP: both clouds thinned to `voxel_m`, correspondences up to
 // `max_correspondence_m` apart.
 struct GicpStage {
@@ -49,6 +53,11 @@ class GicpMatcher {
 
   // Fills transform, iterations, converged and message.
   RegistrationResult align(const Eigen::Isometry3d& initial, Dof dof) const;
+
+  // The k-d tree of a stage that takes the target as given (voxel_m 0: the fine stage by
+  // default), over a copy of exactly its points in their order; null without such a stage.
+  // Judging results against the same target can reuse it (AlignmentJudge).
+  const detail::PointKdTree* unthinned_target_tree() const;
 
   struct Stage;  // one pass's clouds, covariances and k-d tree (gicp.cpp)
 
