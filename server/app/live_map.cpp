@@ -105,7 +105,7 @@ std::optional<MapMatch> LiveMap::place(const PointCloud& scan, const Pose& repor
     in = mission_.match_input(reported, robot);
   }
   if (!in) return std::nullopt;
-  return match_to_map(in->map_points, scan, in->prior, in->config);
+  return match_to_map(in->map_points, scan, in->prior, in->config, in->views);
 }
 
 LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {

@@ -83,18 +83,37 @@ std::vector<std::pair<std::uint64_t, std::uint32_t>> representatives(const Point
 
 }  // namespace
 
-PointCloud voxel_downsample(const PointCloud& cloud, double voxel_m) {
-  PointCloud out;
+std::vector<std::uint32_t> voxel_kept(const PointCloud& cloud, double voxel_m) {
+  std::vector<std::uint32_t> kept;
   if (!(voxel_m > 0)) {
-    out.points.reserve(cloud.size());
-    for (const auto& p : cloud.points) {
-      if (p.allFinite()) out.points.push_back(p);
+    kept.reserve(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      if (cloud.points[i].allFinite()) kept.push_back(static_cast<std::uint32_t>(i));
     }
-    return out;
+    return kept;
   }
   const auto reps = representatives(cloud, voxel_m);
-  out.points.reserve(reps.size());
-  for (const auto& [key, index] : reps) out.points.push_back(cloud.points[index]);
+  kept.reserve(reps.size());
+  for (const auto& [key, index] : reps) kept.push_back(index);
+  return kept;
+}
+
+PointCloud picked(const PointCloud& cloud, const std::vector<std::uint32_t>& kept) {
+  PointCloud out;
+  out.points.reserve(kept.size());
+  for (const std::uint32_t i : kept) out.points.push_back(cloud.points[i]);
+  if (cloud.has_colors()) {
+    out.colors.reserve(kept.size());
+    for (const std::uint32_t i : kept) out.colors.push_back(cloud.colors[i]);
+  }
+  return out;
+}
+
+PointCloud voxel_downsample(const PointCloud& cloud, double voxel_m) {
+  const std::vector<std::uint32_t> kept = voxel_kept(cloud, voxel_m);
+  PointCloud out;
+  out.points.reserve(kept.size());
+  for (const std::uint32_t i : kept) out.points.push_back(cloud.points[i]);
   return out;
 }
 

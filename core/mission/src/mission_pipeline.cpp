@@ -83,15 +83,17 @@ std::optional<MissionPipeline::MatchInput> MissionPipeline::match_input(
       config = widened(config, *prior);
     }
   }
-  return MatchInput{points_near(start.x, start.y, config.target_radius_m, /*anchored_only=*/true),
-                    config, start};
+  MatchInput in{{}, config, start, {{}, scanner_view()}};
+  in.map_points = points_near(start.x, start.y, config.target_radius_m, /*anchored_only=*/true,
+                              &in.views.target);
+  return in;
 }
 
 std::optional<MapMatch> MissionPipeline::place(const PointCloud& scan, const Pose& reported,
                                                const std::string& track) const {
   const std::optional<MatchInput> in = match_input(reported, track);
   if (!in) return std::nullopt;
-  return match_to_map(in->map_points, scan, in->prior, in->config);
+  return match_to_map(in->map_points, scan, in->prior, in->config, in->views);
 }
 
 std::shared_ptr<const PointCloud> MissionPipeline::to_map_frame(const PointCloud& scan,
@@ -129,7 +131,7 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
   }
   const std::vector<Pose> before = poses_;
   const std::optional<SensorFix> fix = where.matched ? std::nullopt : sensors_place(where);
-  GraphUpdate update = graph_->add(scan, where, where.matched && unsure(where));
+  GraphUpdate update = graph_->add(scan, where, where.matched && unsure(where), scanner_view());
   const std::size_t k = placed_.size() - 1;
   if (fix && !graph_->anchored(k)) {
     graph_->anchor_by_sensors(k, fix->from, fix->information);
@@ -228,9 +230,11 @@ bool MissionPipeline::rematch_refused(GraphUpdate& update) {
     if (near <= anchored_near_[u]) continue;
     anchored_near_[u] = near;
     ++update.rematches_tried;
-    const MapMatch m =
-        match_to_map(points_near(at.x, at.y, radius, /*anchored_only=*/true), graph_->thinned(u),
-                     level(at), widened(*config_.matching, graph_->uncertainty(u)));
+    MatchViews views{{}, scanner_view()};
+    const PointCloud around =
+        points_near(at.x, at.y, radius, /*anchored_only=*/true, &views.target);
+    const MapMatch m = match_to_map(around, graph_->thinned(u), level(at),
+                                    widened(*config_.matching, graph_->uncertainty(u)), views);
     if (!m.applied) continue;
     if (beyond_reach(graph_->uncertainty(u)) ||
         change(at, m.placed).metres > config_.matching->max_correction_m) {
@@ -380,18 +384,30 @@ void MissionPipeline::set_target(TargetRegion target) {
   mapping_.set_target(std::move(target));
 }
 
-PointCloud MissionPipeline::points_near(double x, double y, double radius_m,
-                                        bool anchored_only) const {
+PointCloud MissionPipeline::points_near(double x, double y, double radius_m, bool anchored_only,
+                                        Viewpoints* views) const {
   PointCloud out;
+  if (views) *views = {};
   const Eigen::Vector2f c(static_cast<float>(x), static_cast<float>(y));
   const float r2 = static_cast<float>(radius_m * radius_m);
+  const Eigen::Vector3f sensor = scanner_view().origins.front();
   for (std::size_t i = 0; i < placed_.size(); ++i) {
     if (anchored_only && !anchored_[i]) continue;
+    const std::size_t before = out.size();
     for (const auto& p : placed_[i]->points) {
       if ((p.head<2>() - c).squaredNorm() <= r2) out.points.push_back(p);
     }
+    if (views && out.size() > before) {
+      // The scan's points are in the map frame at cloud_poses_[i]; so is its scanner.
+      views->origins.push_back(cloud_poses_[i].isometry().cast<float>() * sensor);
+      views->origin_of.resize(out.size(), static_cast<std::uint32_t>(views->origins.size() - 1));
+    }
   }
   return out;
+}
+
+Viewpoints MissionPipeline::scanner_view() const {
+  return Viewpoints::single({0, 0, static_cast<float>(config_.mapping.sensor_height_m)});
 }
 
 }  // namespace scanplan

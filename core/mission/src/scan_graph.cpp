@@ -112,7 +112,8 @@ std::optional<std::size_t> ScanGraph::last_of(const std::string& track) const {
   return it->second;
 }
 
-GraphUpdate ScanGraph::add(const PointCloud& scan, const Placement& where, bool tentative) {
+GraphUpdate ScanGraph::add(const PointCloud& scan, const Placement& where, bool tentative,
+                           const Viewpoints& scanner) {
   const MoveUncertainty uncertain =
       where.matched && !tentative
           ? MoveUncertainty{}
@@ -121,6 +122,7 @@ GraphUpdate ScanGraph::add(const PointCloud& scan, const Placement& where, bool 
   const RegistrationConfig adapted = adapted_config(scan, config_.registration);
   thinned_.push_back(std::make_shared<const PointCloud>(
       levelled(voxel_downsample(scan, adapted.voxel_m), where.placed)));
+  scanners_.push_back(scanner);
   reported_.push_back(where.reported);
   tracks_.push_back(where.track);
   const bool matched = where.matched && !tentative;
@@ -311,7 +313,8 @@ std::optional<GraphEdge> ScanGraph::match_pair(std::size_t from, std::size_t to)
   // One end is not anchored (match_pairs): where it lies may be metres off.
   const RegistrationResult r =
       register_scans(*thinned_[from], *thinned_[to], initial, Method::kSearchGicp,
-                     widened(config_.registration, relative_uncertainty(from, to)));
+                     widened(config_.registration, relative_uncertainty(from, to)),
+                     {scanners_[from], scanners_[to]});
   if (!r.converged) return std::nullopt;
   // How far the result is from where the graph had the pair, in `from`'s levelled frame (the
   // clouds are levelled: the transform is the relative pose itself).

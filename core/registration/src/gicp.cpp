@@ -23,17 +23,20 @@ namespace {
 constexpr int kNeighbours = 10;
 
 // A cloud with its k-d tree and each point's neighbourhood covariance, flattened to a plane
-// (GicpConfig::plane_epsilon). The covariances are computed when first asked for: at the
-// planner's spacing most points of either scan never find a partner, and the neighbour search
-// behind a covariance is the largest single cost of GICP.
+// (GicpConfig::plane_epsilon), and with viewpoints its surface normal turned toward the scanner
+// that saw it. Both are computed when first asked for: at the planner's spacing most points of
+// either scan never find a partner, and the neighbour search behind a covariance is the largest
+// single cost of GICP.
 class CovariedCloud {
  public:
-  CovariedCloud(PointCloud cloud, float neighbour_radius, double epsilon)
+  CovariedCloud(PointCloud cloud, Viewpoints views, float neighbour_radius, double epsilon)
       : cloud_(std::move(cloud)),
+        views_(std::move(views)),
         tree_(cloud_.points),
         radius_sq_(neighbour_radius * neighbour_radius),
         epsilon_(epsilon),
         cov_(cloud_.size()),
+        normal_(views_.known() ? cloud_.size() : 0, Eigen::Vector3d::Zero()),
         known_(cloud_.size(), 0) {}
 
   const detail::PointKdTree& tree() const { return tree_; }
@@ -44,38 +47,57 @@ class CovariedCloud {
   // attracts, but weakly in every direction.
   const Eigen::Matrix3d& covariance(std::uint32_t i) const {
     if (!known_[i]) {
-      cov_[i] = plane_covariance(cloud_.points[i]);
+      cov_[i] = plane_covariance(i);
       known_[i] = 1;
     }
     return cov_[i];
   }
 
+  bool has_normals() const { return !normal_.empty(); }
+  // Zero where the neighbourhood is too thin for a plane.
+  const Eigen::Vector3d& normal(std::uint32_t i) const {
+    covariance(i);
+    return normal_[i];
+  }
+
  private:
-  Eigen::Matrix3d plane_covariance(const Eigen::Vector3f& q) const {
+  Eigen::Matrix3d plane_covariance(std::uint32_t i) const {
+    const Eigen::Vector3f& q = cloud_.points[i];
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
     if (!tree_.local_shape<kNeighbours>(q, radius_sq_, eig)) return Eigen::Matrix3d::Identity();
+    if (has_normals()) {
+      const Eigen::Vector3d n = eig.eigenvectors().col(0);
+      normal_[i] = n.dot((views_.of(i) - q).cast<double>()) < 0 ? -n : n;
+    }
     const Eigen::Vector3d values(epsilon_, 1.0, 1.0);
     return eig.eigenvectors() * values.asDiagonal() * eig.eigenvectors().transpose();
   }
 
   PointCloud cloud_;
+  Viewpoints views_;
   detail::PointKdTree tree_;  // over cloud_.points, which never move
   float radius_sq_;
   double epsilon_;
   mutable std::vector<Eigen::Matrix3d> cov_;
+  mutable std::vector<Eigen::Vector3d> normal_;  // empty without viewpoints
   mutable std::vector<std::uint8_t> known_;
 };
 
 }  // namespace
 
 struct GicpMatcher::Stage {
-  Stage(const GicpStage& l, PointCloud target_points, PointCloud source_points, double epsilon)
+  Stage(const GicpStage& l, PointCloud target_points, Viewpoints target_views,
+        PointCloud source_points, Viewpoints source_views, const GicpConfig& config)
       : lengths(l),
         // Neighbours farther than a correspondence may reach do not describe the surface there.
-        target(std::move(target_points), static_cast<float>(l.max_correspondence_m), epsilon),
-        source(std::move(source_points), static_cast<float>(l.max_correspondence_m), epsilon) {}
+        target(std::move(target_points), std::move(target_views),
+               static_cast<float>(l.max_correspondence_m), config.plane_epsilon),
+        source(std::move(source_points), std::move(source_views),
+               static_cast<float>(l.max_correspondence_m), config.plane_epsilon),
+        min_normal_agreement(config.min_normal_agreement) {}
   GicpStage lengths;
   CovariedCloud target, source;
+  double min_normal_agreement;
 };
 
 namespace {
@@ -102,6 +124,10 @@ Linearised<N> linearise(const GicpMatcher::Stage& s, const Eigen::Isometry3d& T)
     std::uint32_t index[1];
     float sq[1];
     if (s.target.tree().nearest<1>(p.cast<float>(), max_sq, index, sq) == 0) continue;
+    if (s.target.has_normals() && s.source.has_normals() &&
+        s.target.normal(index[0]).dot(R * s.source.normal(i)) < s.min_normal_agreement) {
+      continue;  // the other face of a thin surface (a zero normal agrees with anything)
+    }
     const Eigen::Vector3d d = s.target.cloud().points[index[0]].cast<double>() - p;
     const Eigen::Matrix3d C =
         s.target.covariance(index[0]) + R * s.source.covariance(i) * R.transpose();
@@ -120,14 +146,23 @@ Linearised<N> linearise(const GicpMatcher::Stage& s, const Eigen::Isometry3d& T)
 }  // namespace
 
 GicpMatcher::GicpMatcher(const PointCloud& target, const PointCloud& source,
-                         const GicpConfig& config)
+                         const GicpConfig& config, const MatchViews& views)
     : config_(config) {
+  // Viewpoints that do not describe these clouds are not used (nor are one cloud's alone).
+  const bool viewed = views.target.fit(target.size()) && views.source.fit(source.size());
+  // Each stage's clouds thinned as it asks, with the viewpoints of the points kept.
+  const auto thinned = [&](const PointCloud& cloud, const Viewpoints& seen, double voxel_m) {
+    if (!(voxel_m > 0)) return std::make_pair(cloud, viewed ? seen : Viewpoints{});
+    std::vector<std::uint32_t> kept = voxel_kept(cloud, voxel_m);
+    return std::make_pair(picked(cloud, kept), viewed ? seen.picked(kept) : Viewpoints{});
+  };
   stages_.reserve(config.stages.size());
   for (const GicpStage& lengths : config.stages) {
-    const double source_voxel = std::max(lengths.voxel_m, lengths.source_voxel_m);
-    stages_.push_back(std::make_unique<Stage>(
-        lengths, lengths.voxel_m > 0 ? voxel_downsample(target, lengths.voxel_m) : target,
-        source_voxel > 0 ? voxel_downsample(source, source_voxel) : source, config.plane_epsilon));
+    auto [t, t_views] = thinned(target, views.target, lengths.voxel_m);
+    auto [s, s_views] =
+        thinned(source, views.source, std::max(lengths.voxel_m, lengths.source_voxel_m));
+    stages_.push_back(std::make_unique<Stage>(lengths, std::move(t), std::move(t_views),
+                                              std::move(s), std::move(s_views), config));
   }
 }
 
@@ -193,8 +228,9 @@ RegistrationResult GicpMatcher::align(const Eigen::Isometry3d& initial, Dof dof)
 }
 
 RegistrationResult align_gicp(const PointCloud& target, const PointCloud& source,
-                              const Eigen::Isometry3d& initial, Dof dof, const GicpConfig& config) {
-  return GicpMatcher(target, source, config).align(initial, dof);
+                              const Eigen::Isometry3d& initial, Dof dof, const GicpConfig& config,
+                              const MatchViews& views) {
+  return GicpMatcher(target, source, config, views).align(initial, dof);
 }
 
 }  // namespace scanplan

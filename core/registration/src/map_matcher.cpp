@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <vector>
 
 #include "scanplan/geometry/pose_information.hpp"
 #include "scanplan/registration/pose_search.hpp"
@@ -20,7 +22,7 @@ constexpr double kGateFloorDeg = 1.0;
 }  // namespace
 
 MapMatch match_to_map(const PointCloud& map_points, const PointCloud& scan, const Pose& reported,
-                      const MapMatchConfig& config) {
+                      const MapMatchConfig& config, const MatchViews& views) {
   MapMatch out;
   out.placed = reported;
   out.proposed = reported;
@@ -34,15 +36,24 @@ MapMatch match_to_map(const PointCloud& map_points, const PointCloud& scan, cons
   const Eigen::Isometry3f level_from_map = map_from_level.inverse().cast<float>();
 
   PointCloud target;
+  std::vector<std::uint32_t> kept;
   const float r2 = static_cast<float>(config.target_radius_m * config.target_radius_m);
   const Eigen::Vector2f center(static_cast<float>(reported.x), static_cast<float>(reported.y));
-  for (const auto& p : map_points.points) {
-    if ((p.head<2>() - center).squaredNorm() <= r2) target.points.push_back(level_from_map * p);
+  for (std::size_t i = 0; i < map_points.size(); ++i) {
+    const Eigen::Vector3f& p = map_points.points[i];
+    if ((p.head<2>() - center).squaredNorm() <= r2) {
+      target.points.push_back(level_from_map * p);
+      kept.push_back(static_cast<std::uint32_t>(i));
+    }
+  }
+  MatchViews level_views;  // the target's viewpoints in the levelled frame too
+  if (views.target.fit(map_points.size())) {
+    level_views = {views.target.picked(kept).transformed(level_from_map), views.source};
   }
   const Eigen::Isometry3d initial = map_from_level.inverse() * reported.isometry();
   RegistrationConfig sized = adapted_config(scan, config.registration);
   sized.adapt_to_scene = false;
-  out.result = register_scans(target, scan, initial, config.method, sized);
+  out.result = register_scans(target, scan, initial, config.method, sized, level_views);
   const Pose corrected = Pose::from_isometry(map_from_level * out.result.transform);
   if (out.result.iterations > 0) out.proposed = corrected;
   // The level frame is the map's turned by the reported yaw.

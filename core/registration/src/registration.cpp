@@ -113,9 +113,9 @@ std::optional<std::string> ambiguous(
 // search peak can be a false one (a facade shifted along itself, a repeated row of cars); the
 // check, not the search score, tells which refinement to believe.
 RegistrationResult align_search_gicp(const PointCloud& target, const PointCloud& source,
-                                     const Eigen::Isometry3d& initial,
-                                     const RegistrationConfig& c) {
-  const GicpMatcher gicp(target, source, c.gicp);
+                                     const Eigen::Isometry3d& initial, const RegistrationConfig& c,
+                                     const MatchViews& views) {
+  const GicpMatcher gicp(target, source, c.gicp, views);
   const AlignmentJudge judge(target, gicp.unthinned_target_tree());
   // Which result to keep is judged on every third source point, a third of the cost; the kept
   // one is judged again on all of them (register_with).
@@ -165,7 +165,7 @@ RegistrationResult align_search_gicp(const PointCloud& target, const PointCloud&
 
 RegistrationResult align_ours(const PointCloud& target, const PointCloud& source,
                               const Eigen::Isometry3d& initial, Method method,
-                              const RegistrationConfig& c) {
+                              const RegistrationConfig& c, const MatchViews& views) {
   switch (method) {
     case Method::kNdtIcp:
       return align_ndt_icp(target, source, initial, c.dof, c.ndt, c.icp);
@@ -174,9 +174,9 @@ RegistrationResult align_ours(const PointCloud& target, const PointCloud& source
     case Method::kIcp:
       return align_line_segment_icp(target, source, initial, c.dof, c.icp);
     case Method::kGicp:
-      return align_gicp(target, source, initial, c.dof, c.gicp);
+      return align_gicp(target, source, initial, c.dof, c.gicp, views);
     case Method::kSearchGicp:
-      return align_search_gicp(target, source, initial, c);
+      return align_search_gicp(target, source, initial, c, views);
   }
   return failed(method_name(method), "unknown method");
 }
@@ -259,17 +259,19 @@ RegistrationConfig adapted_config(const PointCloud& target, const RegistrationCo
 
 RegistrationResult register_scans(const PointCloud& target, const PointCloud& source,
                                   const Eigen::Isometry3d& initial, Method method,
-                                  const RegistrationConfig& config) {
+                                  const RegistrationConfig& config, const MatchViews& views) {
   return register_with(
       target, source, initial, method_name(method),
       [method](const PointCloud& t, const PointCloud& s, const Eigen::Isometry3d& start,
-               const RegistrationConfig& c, double) { return align_ours(t, s, start, method, c); },
-      config);
+               const RegistrationConfig& c, double,
+               const MatchViews& v) { return align_ours(t, s, start, method, c, v); },
+      config, views);
 }
 
 RegistrationResult register_with(const PointCloud& target, const PointCloud& source,
                                  const Eigen::Isometry3d& initial, std::string_view method,
-                                 const Aligner& align, const RegistrationConfig& config) {
+                                 const Aligner& align, const RegistrationConfig& config,
+                                 const MatchViews& views) {
   if (target.empty()) return failed(method, "the target cloud is empty");
   if (source.empty()) return failed(method, "the source cloud is empty");
   if (!initial.matrix().allFinite()) {
@@ -277,8 +279,13 @@ RegistrationResult register_with(const PointCloud& target, const PointCloud& sou
   }
   const double scale = length_scale(target, config);
   const RegistrationConfig c = adapted_config(target, config);
-  const PointCloud t = voxel_downsample(target, c.voxel_m);
-  const PointCloud s = voxel_downsample(source, c.voxel_m);
+  const std::vector<std::uint32_t> t_kept = voxel_kept(target, c.voxel_m);
+  const std::vector<std::uint32_t> s_kept = voxel_kept(source, c.voxel_m);
+  const PointCloud t = picked(target, t_kept), s = picked(source, s_kept);
+  MatchViews thinned_views;  // unknown unless both describe their clouds
+  if (views.target.fit(target.size()) && views.source.fit(source.size())) {
+    thinned_views = {views.target.picked(t_kept), views.source.picked(s_kept)};
+  }
   const std::size_t need = std::max<std::size_t>(c.min_points, 1);
   if (t.size() < need || s.size() < need) {
     return failed(method, "too few points to match: target " + std::to_string(t.size()) +
@@ -288,7 +295,7 @@ RegistrationResult register_with(const PointCloud& target, const PointCloud& sou
   }
 
   const auto started = std::chrono::steady_clock::now();
-  RegistrationResult r = align(t, s, initial, c, scale);
+  RegistrationResult r = align(t, s, initial, c, scale, thinned_views);
   r.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
   r.method = std::string(method);

@@ -124,7 +124,7 @@ RegistrationResult register_scans(const PointCloud& target, const PointCloud& so
   return register_with(
       target, source, initial, pcl_name(method),
       [method, &pcl](const PointCloud& t, const PointCloud& s, const Eigen::Isometry3d& start,
-                     const RegistrationConfig& c, double scale) {
+                     const RegistrationConfig& c, double scale, const MatchViews&) {
         return align_pcl(t, s, start, method, c.dof, scale_lengths(pcl, scale));
       },
       config);

@@ -9,6 +9,7 @@
 #include <tuple>
 #include <vector>
 
+#include "scanplan/geometry/viewpoints.hpp"
 #include "scanplan/geometry/voxel_filter.hpp"
 
 namespace scanplan {
@@ -127,7 +128,37 @@ TEST(VoxelDownsample, KeepsThePointNearestEachVoxelsCentroidInVoxelOrder) {
   for (const double voxel : {0.25, 1.0, 3.0}) {
     const std::vector<Eigen::Vector3f> expected = thinned_by_definition(cloud, voxel);
     EXPECT_EQ(voxel_downsample(cloud, voxel).points, expected) << voxel << " m voxels";
+    EXPECT_EQ(picked(cloud, voxel_kept(cloud, voxel)).points, expected) << voxel << " m voxels";
   }
+}
+
+TEST(Viewpoints, FollowTheirPointsThroughThinningAndMoves) {
+  PointCloud cloud;  // two scans' points merged: the first seen from a, the second from b
+  cloud.push_back({0.1f, 0.1f, 0.1f}, {1, 1, 1});
+  cloud.push_back({5.1f, 0.1f, 0.1f}, {2, 2, 2});
+  cloud.push_back({0.2f, 0.2f, 0.2f}, {3, 3, 3});
+  cloud.push_back({std::nanf(""), 0, 0}, {4, 4, 4});
+  const Eigen::Vector3f a(-10, 0, 1), b(10, 0, 1);
+  const Viewpoints views{{a, b}, {0, 1, 1, 0}};
+  ASSERT_TRUE(views.fit(cloud.size()));
+  EXPECT_FALSE(views.fit(3)) << "one index a point";
+  EXPECT_FALSE((Viewpoints{{a}, {0, 1, 0, 0}}).fit(4)) << "an index past the origins";
+  EXPECT_FALSE(Viewpoints{}.fit(4)) << "unknown";
+  EXPECT_TRUE(Viewpoints::single(a).fit(1000));
+
+  const std::vector<std::uint32_t> kept = voxel_kept(cloud, 1.0);
+  ASSERT_EQ(kept.size(), 2u) << "the NaN dropped, the two near the origin one voxel";
+  const PointCloud thin = picked(cloud, kept);
+  const Viewpoints thin_views = views.picked(kept);
+  ASSERT_TRUE(thin_views.fit(thin.size()));
+  for (std::size_t i = 0; i < thin.size(); ++i) {
+    EXPECT_EQ(thin.points[i], cloud.points[kept[i]]);
+    EXPECT_EQ(thin.colors[i], cloud.colors[kept[i]]) << "colours kept";
+    EXPECT_EQ(thin_views.of(i), thin.points[i].x() > 1 ? b : a) << "point " << i;
+  }
+  const Eigen::Isometry3f move(Eigen::Translation3f(1, 2, 3));
+  EXPECT_EQ(views.transformed(move).of(1), Eigen::Vector3f(11, 2, 4));
+  EXPECT_EQ(Viewpoints::single(a).picked(kept).of(1), a) << "one origin stays one origin";
 }
 
 }  // namespace

@@ -18,6 +18,11 @@ namespace scanplan {
 // <= 0 returns the finite points unchanged. The output is ordered by voxel, so the same input
 // always gives the same output.
 PointCloud voxel_downsample(const PointCloud& cloud, double voxel_m);
+// The indices of the points voxel_downsample keeps, in its order: for what travels with the
+// points (their viewpoints).
+std::vector<std::uint32_t> voxel_kept(const PointCloud& cloud, double voxel_m);
+// The points `kept` (indices into `cloud`), in that order; colours kept when the cloud has them.
+PointCloud picked(const PointCloud& cloud, const std::vector<std::uint32_t>& kept);
 
 // A growing map thinned to one point per cube of side `voxel_m`, for sending the whole map
 // where bandwidth matters (the server's DDS map topic). Each scan added is thinned as

@@ -71,7 +71,8 @@ class MissionPipeline {
   struct MatchInput {
     PointCloud map_points;
     MapMatchConfig config;
-    Pose prior;  // the reported pose in the map frame: where the match starts
+    Pose prior;        // the reported pose in the map frame: where the match starts
+    MatchViews views;  // where map_points were seen from, and the new scan's scanner
   };
   std::optional<MatchInput> match_input(const Pose& reported, const std::string& track = {}) const;
   // `reported` carried into the map frame by what the anchored scans say of the pose sensors'
@@ -114,8 +115,13 @@ class MissionPipeline {
   void set_target(TargetRegion target);
 
   // The map's points (map frame) within `radius_m` of (x, y) in the x-y plane; only the
-  // anchored scans' when `anchored_only`.
-  PointCloud points_near(double x, double y, double radius_m, bool anchored_only = false) const;
+  // anchored scans' when `anchored_only`. With `views`, where each was seen from.
+  PointCloud points_near(double x, double y, double radius_m, bool anchored_only = false,
+                         Viewpoints* views = nullptr) const;
+  // Where the scanner sits in a scan's own frame (PipelineConfig::sensor_height_m above its
+  // origin). Also taken for a scan levelled by its tilt: that moves it a few centimetres, and
+  // which way a surface faces from it not at all.
+  Viewpoints scanner_view() const;
   // Whether the i-th scan (in the order they joined) is anchored (see place(); with the graph,
   // whether believed matches tie it to the first scan).
   bool anchored(std::size_t i) const { return anchored_.at(i) != 0; }

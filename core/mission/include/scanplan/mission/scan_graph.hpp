@@ -98,8 +98,10 @@ class ScanGraph {
   // Scan `scan` (own frame) joins at `where`; its pairs are matched and the graph optimised.
   // `tentative`: where.matched, but the match corrected the pose further than the sensors
   // usually err; it ties the scan in once the odometry to the robot's next or previous scan
-  // agrees (confirm_by_odometry).
-  GraphUpdate add(const PointCloud& scan, const Placement& where, bool tentative = false);
+  // agrees (confirm_by_odometry). `scanner`: where the scanner sits in the scan's frame, for
+  // telling the faces of thin surfaces apart in pairwise matches (unknown: not told apart).
+  GraphUpdate add(const PointCloud& scan, const Placement& where, bool tentative = false,
+                  const Viewpoints& scanner = {});
   // A scan not anchored so far was matched to the map after all (MapMatch::placed and
   // ::information): it is tied to the anchored scan nearest to where the match put it. Call
   // solve() after.
@@ -180,6 +182,7 @@ class ScanGraph {
   PoseNoise noise_;
   PoseGraph graph_;
   std::vector<std::shared_ptr<const PointCloud>> thinned_;  // levelled, per scan
+  std::vector<Viewpoints> scanners_;                        // per scan, as add() was told
   std::vector<Pose> reported_;
   std::vector<std::uint8_t> anchored_;
   std::vector<MoveUncertainty> uncertain_;  // per scan: of its estimate while not anchored

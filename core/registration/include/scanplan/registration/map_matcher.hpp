@@ -61,8 +61,10 @@ struct MapMatch {
 // The pipeline hook of paper §4: the new scan (its own frame) matched against the map built so
 // far (map frame), starting from the reported pose. The match runs in a levelled frame at the
 // reported position, so the 4-DOF solver turns about the true vertical and keeps the measured
-// roll and pitch.
+// roll and pitch. `views`: where the map's points were seen from (map frame) and where the scan's
+// scanner sits in its own frame; with them the faces of thin surfaces are told apart
+// (register_scans).
 MapMatch match_to_map(const PointCloud& map_points, const PointCloud& scan, const Pose& reported,
-                      const MapMatchConfig& config = {});
+                      const MapMatchConfig& config = {}, const MatchViews& views = {});
 
 }  // namespace scanplan

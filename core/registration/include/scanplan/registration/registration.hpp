@@ -123,24 +123,29 @@ RegistrationConfig adapted_config(const PointCloud& target, const RegistrationCo
 
 // One alignment of clouds already thinned, with the configuration already adapted to the scene
 // (`length_scale` is the factor it was adapted by): the part that differs between methods.
-// Fills transform, iterations, converged and message.
+// Fills transform, iterations, converged and message. `views` are the thinned clouds'
+// viewpoints when the caller gave them (unknown otherwise).
 using Aligner = std::function<RegistrationResult(
     const PointCloud& target, const PointCloud& source, const Eigen::Isometry3d& initial,
-    const RegistrationConfig& adapted, double length_scale)>;
+    const RegistrationConfig& adapted, double length_scale, const MatchViews& views)>;
 
 // What every method shares around its alignment: the input checks, the scene adaptation, the
 // thinning, the timing, the Eq. 2 score and the sanity check behind `converged`. `method` names
 // the result.
 RegistrationResult register_with(const PointCloud& target, const PointCloud& source,
                                  const Eigen::Isometry3d& initial, std::string_view method,
-                                 const Aligner& align, const RegistrationConfig& config = {});
+                                 const Aligner& align, const RegistrationConfig& config = {},
+                                 const MatchViews& views = {});
 
 // Finds the transform that maps `source` into `target`, starting from `initial`. Bad input
 // (an empty cloud, too few points, a non-finite initial transform, clouds that do not overlap)
 // is not an exception: it gives converged = false with the reason in `message`, and never a
-// wrong pose marked converged as far as the sanity check can tell.
+// wrong pose marked converged as far as the sanity check can tell. With `views` (where each
+// cloud was seen from, in its own frame) gicp and search-gicp tell the faces of thin surfaces
+// apart (GicpConfig::min_normal_agreement); the paper's methods do not use them.
 RegistrationResult register_scans(const PointCloud& target, const PointCloud& source,
                                   const Eigen::Isometry3d& initial, Method method = Method::kNdtIcp,
-                                  const RegistrationConfig& config = {});
+                                  const RegistrationConfig& config = {},
+                                  const MatchViews& views = {});
 
 }  // namespace scanplan
