@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "scanplan/geometry/viewpoints.hpp"
 #include "scanplan/geometry/voxel_filter.hpp"
 #include "scanplan/registration/alignment_quality.hpp"
 #include "scanplan/registration/registration.hpp"
@@ -53,9 +54,18 @@ struct Args {
   // was right: the data the check's thresholds are calibrated on.
   std::string features;
   std::string world = SCANPLAN_SOURCE_DIR "/samples/worlds/campus.json";
-  std::vector<std::string> methods{
-      "ndt-icp",     "ndt",     "icp",     "ndt-icp-6dof", "ndt-icp-paper-cells", "gicp",
-      "search-gicp", "pcl-ndt", "pcl-icp", "pcl-gicp",     "pcl-ndt+pcl-icp"};
+  std::vector<std::string> methods{"ndt-icp",
+                                   "ndt",
+                                   "icp",
+                                   "ndt-icp-6dof",
+                                   "ndt-icp-paper-cells",
+                                   "gicp",
+                                   "search-gicp",
+                                   "search-gicp-blind",
+                                   "pcl-ndt",
+                                   "pcl-icp",
+                                   "pcl-gicp",
+                                   "pcl-ndt+pcl-icp"};
 };
 
 // x, y, z and yaw only: the scans are levelled by their measured roll and pitch.
@@ -131,6 +141,9 @@ struct Pair {
   Eigen::Isometry3d truth, initial;
   double constraint = 0;  // weakest constraint at the truth
   std::string where;
+  // Where each scanner stood (levelled frames: its mount above the origin), as the loop gives
+  // gicp and search-gicp; the "-blind" variants match without.
+  MatchViews views;
 };
 
 // What register_scans does before matching — fit the configuration to the target and thin both
@@ -177,6 +190,8 @@ PairSets make_pairs(const Campus& campus, int count, Band band, double xy_sigma,
     if (dist < band.min_m || dist > band.max_m) continue;
     Pair p;
     prepare(p, campus.scan(a, rng()), campus.scan(b, rng()), base);
+    const auto mount = static_cast<float>(campus.world().scanner.mount_height_m);
+    p.views = {Viewpoints::single({0, 0, mount}), Viewpoints::single({0, 0, mount})};
     p.truth = flat(a).inverse() * flat(b);
     p.initial = flat(a).inverse() * flat(disturbed(b, xy_sigma, yaw_deg, rng));
     p.constraint = evaluate_alignment(p.target, p.source, p.truth, Dof::k4,
@@ -213,7 +228,9 @@ constexpr double kPclRefineCorrespondenceM = 0.3;
 // One named method of the comparison. "ndt-icp-6dof" is ours without the inclination
 // constraint; "ndt-icp-paper-cells" ours with the paper's 20/15/10 m NDT cells as they are, not
 // scaled to the scene; "pcl-ndt+pcl-icp" is PCL's NDT refined by PCL's ICP (the PCL
-// counterpart of our combination), which reuses the pcl-ndt result of the same pair;
+// counterpart of our combination), which reuses the pcl-ndt result of the same pair; "gicp" and
+// "search-gicp" are given where the scanners stood, as in the loop, "gicp-blind" and
+// "search-gicp-blind" are not (GicpConfig::min_normal_agreement);
 // "search-gicp-no-restart" search-gicp without the restart check (RegistrationConfig::
 // restart_check), the sanity check as it was calibrated.
 RegistrationResult run_method(const std::string& name, const Pair& p,
@@ -239,7 +256,16 @@ RegistrationResult run_method(const std::string& name, const Pair& p,
   if (name == "search-gicp-no-restart") {
     RegistrationConfig plain = c;
     plain.restart_check = false;
-    return register_scans(p.target, p.source, p.initial, Method::kSearchGicp, plain);
+    return register_scans(p.target, p.source, p.initial, Method::kSearchGicp, plain, p.views);
+  }
+  if (name == "gicp" || name == "search-gicp") {
+    return register_scans(p.target, p.source, p.initial, *parse_method(name), c, p.views);
+  }
+  if (name == "gicp-blind" || name == "search-gicp-blind") {
+    RegistrationResult r = register_scans(p.target, p.source, p.initial,
+                                          *parse_method(name.substr(0, name.size() - 6)), c);
+    r.method = name;
+    return r;
   }
   if (name == "ndt-icp-paper-cells") {
     RegistrationConfig paper = c;
@@ -414,7 +440,8 @@ std::optional<Args> parse_args(int argc, char** argv) {
   }
   for (const auto& m : a.methods) {
     if (!parse_any_method(m) && m != "ndt-icp-6dof" && m != "ndt-icp-paper-cells" &&
-        m != "pcl-ndt+pcl-icp" && m != "search-gicp-no-restart") {
+        m != "pcl-ndt+pcl-icp" && m != "search-gicp-no-restart" && m != "gicp-blind" &&
+        m != "search-gicp-blind") {
       std::fprintf(stderr, "unknown method %s\n", m.c_str());
       return std::nullopt;
     }

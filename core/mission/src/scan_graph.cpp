@@ -40,6 +40,12 @@ PointCloud levelled(PointCloud scan, const Pose& pose) {
   return scan;
 }
 
+RegistrationConfig pair_registration() {
+  RegistrationConfig c;
+  c.range_by_direction = true;
+  return c;
+}
+
 RegistrationConfig widened(RegistrationConfig config, const MoveUncertainty& prior) {
   config.search.prior_sigma_xy_m = prior.xy_m;
   config.search.prior_sigma_yaw_deg = prior.yaw_deg;

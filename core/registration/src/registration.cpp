@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -197,6 +198,18 @@ std::string_view method_name(Method method) {
   return "unknown";
 }
 
+namespace {
+
+// The q-quantile of `values` (reordered), which must not be empty.
+float quantile(std::vector<float>& values, double q) {
+  const auto at =
+      values.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(values.size() - 1));
+  std::nth_element(values.begin(), at, values.end());
+  return *at;
+}
+
+}  // namespace
+
 double scene_range_m(const PointCloud& cloud) {
   std::vector<float> ranges;
   ranges.reserve(cloud.size());
@@ -204,10 +217,27 @@ double scene_range_m(const PointCloud& cloud) {
     if (p.allFinite()) ranges.push_back(p.norm());
   }
   if (ranges.empty()) return 0;
-  const auto at =
-      ranges.begin() + static_cast<std::ptrdiff_t>(0.9 * static_cast<double>(ranges.size() - 1));
-  std::nth_element(ranges.begin(), at, ranges.end());
-  return *at;
+  return quantile(ranges, 0.9);
+}
+
+double open_range_m(const PointCloud& cloud) {
+  constexpr int kSectors = 36;
+  constexpr std::size_t kMinSectorPoints = 20;
+  std::array<std::vector<float>, kSectors> sectors;
+  std::size_t finite = 0;
+  for (const auto& p : cloud.points) {
+    if (!p.allFinite()) continue;
+    ++finite;
+    const double turn = (std::atan2(p.y(), p.x()) + M_PI) / (2 * M_PI);
+    sectors[std::clamp(static_cast<int>(turn * kSectors), 0, kSectors - 1)].push_back(p.norm());
+  }
+  std::vector<float> reach;
+  for (auto& sector : sectors) {
+    if (sector.size() >= kMinSectorPoints) reach.push_back(quantile(sector, 0.9));
+  }
+  // Too few points for any sector to say: over all of them.
+  if (reach.empty()) return finite ? scene_range_m(cloud) : 0;
+  return quantile(reach, 0.9);
 }
 
 RegistrationConfig scale_lengths(const RegistrationConfig& config, double factor) {
@@ -239,7 +269,7 @@ namespace {
 // floor keeps lengths from collapsing to nothing on a handful of points.
 double scale_for(const PointCloud& target, const RegistrationConfig& config, double reference) {
   if (!config.adapt_to_scene || !(reference > 0)) return 1.0;
-  const double range = scene_range_m(target);
+  const double range = config.range_by_direction ? open_range_m(target) : scene_range_m(target);
   if (!(range > 0)) return 1.0;
   return std::clamp(range / reference, 0.01, 1.0);
 }

@@ -393,5 +393,34 @@ TEST(Registration, CellSizesAdaptToShortRangeData) {
   EXPECT_EQ(adapted_config(small, fixed).ndt.cell_sizes_m, defaults.ndt.cell_sizes_m);
 }
 
+TEST(Registration, AWallBesideTheScannerDoesNotShortenItsOpenRange) {
+  // Open ground seen to 30 m all round, and a wall 1.5 m to the east that takes most points.
+  PointCloud beside_wall, courtyard;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> turn(-3.14159f, 3.14159f), reach(2, 30), along(-6, 6),
+      up(0, 5);
+  for (int i = 0; i < 6000; ++i) {
+    const float a = turn(rng), r = reach(rng);
+    beside_wall.points.emplace_back(r * std::cos(a), r * std::sin(a), 0);
+  }
+  for (int i = 0; i < 60000; ++i) beside_wall.points.emplace_back(1.5f, along(rng), up(rng));
+  // Walls 7 m away all round: short whichever way it is measured.
+  for (int i = 0; i < 20000; ++i) {
+    const float a = turn(rng);
+    courtyard.points.emplace_back(7 * std::cos(a), 7 * std::sin(a), up(rng));
+  }
+  EXPECT_LT(scene_range_m(beside_wall), 12) << "over all points, the wall's";
+  EXPECT_GT(open_range_m(beside_wall), 25) << "where the view is open";
+  EXPECT_NEAR(open_range_m(courtyard), scene_range_m(courtyard), 0.5);
+  EXPECT_LT(open_range_m(courtyard), 9);
+  EXPECT_EQ(open_range_m(PointCloud{}), 0);
+
+  RegistrationConfig by_direction;
+  by_direction.range_by_direction = true;
+  EXPECT_EQ(adapted_config(beside_wall, by_direction).voxel_m, by_direction.voxel_m)
+      << "the campus's lengths as they are";
+  EXPECT_LT(adapted_config(beside_wall, RegistrationConfig{}).voxel_m, by_direction.voxel_m);
+}
+
 }  // namespace
 }  // namespace scanplan

@@ -15,6 +15,10 @@
 
 namespace scanplan {
 
+// Pairwise matching's configuration: the defaults, with the lengths sized by
+// RegistrationConfig::range_by_direction as the map match's are.
+RegistrationConfig pair_registration();
+
 struct ScanGraphConfig {
   PoseGraphConfig solver;
   // Pairwise matches (only where one scan of the pair is not in the map: match_pairs) with the
@@ -24,8 +28,9 @@ struct ScanGraphConfig {
   double pair_radius_m = 45.0;
   std::size_t max_pairs = 6;
   // The pairwise match: the search over how far off the scan not anchored may be, then GICP
-  // (search-gicp), on the scans thinned and levelled.
-  RegistrationConfig registration;
+  // (search-gicp), on the scans thinned and levelled, its lengths sized from how far each scan
+  // sees where its view is open (RegistrationConfig::range_by_direction).
+  RegistrationConfig registration = pair_registration();
   // A pairwise result farther than this from where the graph had the pair is not believed
   // however far the search looked (see widened()): the pose sensors' usual reach
   // (MapMatchConfig::max_correction_m).

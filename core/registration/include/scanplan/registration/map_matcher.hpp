@@ -19,6 +19,7 @@ inline RegistrationConfig map_registration() {
   RegistrationConfig c;
   c.min_inlier_ratio = 0.07;
   c.restart_min_constraint = 0.01;
+  c.range_by_direction = true;
   return c;
 }
 
