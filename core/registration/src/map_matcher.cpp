@@ -19,6 +19,26 @@ constexpr double kChi2Of3Dof99 = 11.34;
 constexpr double kGateFloorM = 0.25;
 constexpr double kGateFloorDeg = 1.0;
 
+// The map's points within `radius_m` (x-y) of the reported position, in the levelled frame, and
+// with them where they were seen from (left unknown unless `views` describe the map's points).
+void crop_to_level_frame(const PointCloud& map_points, const MatchViews& views, double radius_m,
+                         const Pose& reported, const Eigen::Isometry3f& level_from_map,
+                         PointCloud& target, MatchViews& level_views) {
+  std::vector<std::uint32_t> kept;
+  const auto r2 = static_cast<float>(radius_m * radius_m);
+  const Eigen::Vector2f center(static_cast<float>(reported.x), static_cast<float>(reported.y));
+  for (std::size_t i = 0; i < map_points.size(); ++i) {
+    const Eigen::Vector3f& p = map_points.points[i];
+    if ((p.head<2>() - center).squaredNorm() <= r2) {
+      target.points.push_back(level_from_map * p);
+      kept.push_back(static_cast<std::uint32_t>(i));
+    }
+  }
+  if (views.target.fit(map_points.size())) {
+    level_views = {views.target.picked(kept).transformed(level_from_map), views.source};
+  }
+}
+
 }  // namespace
 
 MapMatch match_to_map(const PointCloud& map_points, const PointCloud& scan, const Pose& reported,
@@ -36,20 +56,9 @@ MapMatch match_to_map(const PointCloud& map_points, const PointCloud& scan, cons
   const Eigen::Isometry3f level_from_map = map_from_level.inverse().cast<float>();
 
   PointCloud target;
-  std::vector<std::uint32_t> kept;
-  const float r2 = static_cast<float>(config.target_radius_m * config.target_radius_m);
-  const Eigen::Vector2f center(static_cast<float>(reported.x), static_cast<float>(reported.y));
-  for (std::size_t i = 0; i < map_points.size(); ++i) {
-    const Eigen::Vector3f& p = map_points.points[i];
-    if ((p.head<2>() - center).squaredNorm() <= r2) {
-      target.points.push_back(level_from_map * p);
-      kept.push_back(static_cast<std::uint32_t>(i));
-    }
-  }
-  MatchViews level_views;  // the target's viewpoints in the levelled frame too
-  if (views.target.fit(map_points.size())) {
-    level_views = {views.target.picked(kept).transformed(level_from_map), views.source};
-  }
+  MatchViews level_views;
+  crop_to_level_frame(map_points, views, config.target_radius_m, reported, level_from_map, target,
+                      level_views);
   const Eigen::Isometry3d initial = map_from_level.inverse() * reported.isometry();
   RegistrationConfig sized = adapted_config(scan, config.registration);
   sized.adapt_to_scene = false;

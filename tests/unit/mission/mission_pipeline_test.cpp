@@ -94,6 +94,21 @@ TEST_F(MissionPipelineTest, OnlyAnchoredScansAreMatchedAgainst) {
   ASSERT_TRUE(in);
   EXPECT_EQ(in->map_points.size(),
             mission.points_near(off.x, off.y, in->config.target_radius_m, true).size());
+
+  // Each map point comes with where its scan's scanner stood (the scan's pose, the mount above
+  // it), and the new scan's scanner is the mount above its own origin.
+  const auto mount = static_cast<float>(without_graph.mapping.sensor_height_m);
+  ASSERT_TRUE(in->views.target.fit(in->map_points.size()));
+  ASSERT_EQ(in->views.target.origins.size(), 1u) << "only the anchored scan";
+  EXPECT_TRUE(in->views.target.of(0).isApprox(Eigen::Vector3f(-15, -8, mount)));
+  EXPECT_TRUE(in->views.source.fit(1));
+  EXPECT_EQ(in->views.source.of(0), Eigen::Vector3f(0, 0, mount));
+  Viewpoints both;
+  const PointCloud near = mission.points_near(-4, -8, 30, /*anchored_only=*/false, &both);
+  ASSERT_TRUE(both.fit(near.size()));
+  ASSERT_EQ(both.origins.size(), 2u);
+  EXPECT_TRUE(both.origins[1].isApprox(Eigen::Vector3f(-3, -7, mount)));
+  EXPECT_EQ(both.of(near.size() - 1), both.origins[1]) << "the refused scan's points come last";
 }
 
 // With the graph, a scan the map match refused is matched pairwise with the anchored scans
