@@ -124,9 +124,11 @@ Linearised<N> linearise(const GicpMatcher::Stage& s, const Eigen::Isometry3d& T)
     std::uint32_t index[1];
     float sq[1];
     if (s.target.tree().nearest<1>(p.cast<float>(), max_sq, index, sq) == 0) continue;
-    if (s.target.has_normals() && s.source.has_normals() &&
-        s.target.normal(index[0]).dot(R * s.source.normal(i)) < s.min_normal_agreement) {
-      continue;  // the other face of a thin surface (a zero normal agrees with anything)
+    if (s.target.has_normals() && s.source.has_normals()) {
+      // A point whose neighbourhood is too thin for a plane has no face to tell apart.
+      const Eigen::Vector3d& nt = s.target.normal(index[0]);
+      const Eigen::Vector3d& ns = s.source.normal(i);
+      if (!nt.isZero() && !ns.isZero() && nt.dot(R * ns) < s.min_normal_agreement) continue;
     }
     const Eigen::Vector3d d = s.target.cloud().points[index[0]].cast<double>() - p;
     const Eigen::Matrix3d C =
