@@ -265,26 +265,37 @@ RegistrationConfig scale_lengths(const RegistrationConfig& config, double factor
 
 namespace {
 
+// How far the scanner sees in `target`, measured as `config` says; 0 when lengths are not
+// adapted to the scene.
+double measured_range(const PointCloud& target, const RegistrationConfig& config) {
+  if (!config.adapt_to_scene) return 0;
+  return config.range_by_direction ? open_range_m(target) : scene_range_m(target);
+}
+
 // Below a hundredth of the outdoor scale the data is something else (a table-top scan); the
 // floor keeps lengths from collapsing to nothing on a handful of points.
-double scale_for(const PointCloud& target, const RegistrationConfig& config, double reference) {
-  if (!config.adapt_to_scene || !(reference > 0)) return 1.0;
-  const double range = config.range_by_direction ? open_range_m(target) : scene_range_m(target);
-  if (!(range > 0)) return 1.0;
+double scale_for(double range, double reference) {
+  if (!(reference > 0) || !(range > 0)) return 1.0;
   return std::clamp(range / reference, 0.01, 1.0);
+}
+
+// adapted_config for a target whose range was measured already (the measure is a pass over
+// every point: a whole scan's costs milliseconds).
+RegistrationConfig adapted_to(double range, const RegistrationConfig& config) {
+  RegistrationConfig c = scale_lengths(config, scale_for(range, config.reference_scene_range_m));
+  const double cells = scale_for(range, config.paper_scene_range_m);
+  for (double& cell : c.ndt.cell_sizes_m) cell *= cells;
+  return c;
 }
 
 }  // namespace
 
 double length_scale(const PointCloud& target, const RegistrationConfig& config) {
-  return scale_for(target, config, config.reference_scene_range_m);
+  return scale_for(measured_range(target, config), config.reference_scene_range_m);
 }
 
 RegistrationConfig adapted_config(const PointCloud& target, const RegistrationConfig& config) {
-  RegistrationConfig c = scale_lengths(config, length_scale(target, config));
-  const double cells = scale_for(target, config, config.paper_scene_range_m);
-  for (double& cell : c.ndt.cell_sizes_m) cell *= cells;
-  return c;
+  return adapted_to(measured_range(target, config), config);
 }
 
 RegistrationResult register_scans(const PointCloud& target, const PointCloud& source,
@@ -307,8 +318,9 @@ RegistrationResult register_with(const PointCloud& target, const PointCloud& sou
   if (!initial.matrix().allFinite()) {
     return failed(method, "the initial transform is not finite");
   }
-  const double scale = length_scale(target, config);
-  const RegistrationConfig c = adapted_config(target, config);
+  const double range = measured_range(target, config);
+  const double scale = scale_for(range, config.reference_scene_range_m);
+  const RegistrationConfig c = adapted_to(range, config);
   const std::vector<std::uint32_t> t_kept = voxel_kept(target, c.voxel_m);
   const std::vector<std::uint32_t> s_kept = voxel_kept(source, c.voxel_m);
   const PointCloud t = picked(target, t_kept), s = picked(source, s_kept);

@@ -34,7 +34,6 @@ struct Viewpoints {
 // The viewpoints of the two clouds of a match; either unknown and matching does without.
 struct MatchViews {
   Viewpoints target, source;
-  bool known() const { return target.known() && source.known(); }
 };
 
 }  // namespace scanplan
