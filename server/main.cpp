@@ -146,6 +146,23 @@ void serve(http::ServerConfig config, int count, const http::Router& router,
 }
 
 // The whole server: storage, the application, DDS and HTTP, wired and run until stopped.
+// The parameters the operator last set in this session (the target region, the no-go zones, α,
+// ...), so that a restarted server plans as before. Stored ones it cannot take (from a version
+// that checked less) are reported and left out: the defaults are a working mission.
+void resume_params(const scanplan::SessionStore& session, srv::LiveMap& map) {
+  try {
+    const std::optional<std::string> stored = session.latest_params();
+    if (!stored) return;
+    nlohmann::json j = nlohmann::json::parse(*stored);
+    if (j.contains("target") && j["target"].is_null()) j.erase("target");  // the default square
+    map.set_params(srv::rest::params_from(j, map.params()));
+    spdlog::info("resumed the session's parameters: {}", *stored);
+  } catch (const std::exception& e) {
+    spdlog::warn("the session's stored parameters are not usable ({}): using the defaults",
+                 e.what());
+  }
+}
+
 void run(const Options& o) {
   // A file-size limit (RLIMIT_FSIZE) is a full disk by another name: a write beyond it must fail
   // with EFBIG, which the session store reports, not kill the server with SIGXFSZ.
@@ -173,6 +190,7 @@ void run(const Options& o) {
     mission_config.pose_noise.model = *scanplan::parse_odometry_model(o.odometry);
   }
   srv::LiveMap map(plans, mission_config);
+  resume_params(session, map);
   srv::ScanIntake intake(session, map, events);
   srv::DdsLink dds(o.domain, robots, intake, events);
   srv::Mission mission(map, plans, robots, dds, session, events);

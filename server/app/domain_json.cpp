@@ -129,12 +129,21 @@ json annotation_json(const Annotation& a) {
           {"z", a.z},   {"text", a.text}, {"author", a.author}, {"created_at", a.created_at}};
 }
 
+namespace {
+
+json corners_json(const TargetRegion& region) {
+  json corners = json::array();
+  for (const auto& c : region.corners()) corners.push_back({c.x(), c.y()});
+  return corners;
+}
+
+}  // namespace
+
 json params_json(const MissionParams& p) {
   json target = nullptr;
-  if (p.target) {
-    target = json::array();
-    for (const auto& c : p.target->corners()) target.push_back({c.x(), c.y()});
-  }
+  if (p.target) target = corners_json(*p.target);
+  json no_go = json::array();
+  for (const TargetRegion& zone : p.planner.no_go) no_go.push_back(corners_json(zone));
   return {{"alpha", p.planner.alpha},
           {"policy", std::string(policy_name(p.planner.policy))},
           {"max_candidates", p.planner.max_candidates},
@@ -142,7 +151,8 @@ json params_json(const MissionParams& p) {
           {"travel_free_m", p.planner.travel_free_m},
           {"completed_radius_m", p.planner.regions.completed_radius_m},
           {"max_step_m", p.planner.movable.max_step_m},
-          {"target", target}};
+          {"target", target},
+          {"no_go", no_go}};
 }
 
 json approval_json(const Approval& a) {

@@ -371,6 +371,9 @@ GoalSite goal_site(const MappingPipeline& mapping, const PlannerConfig& planner,
     throw GoalRefused("outside_target",
                       std::string(where) + " is outside the target region being mapped");
   }
+  if (in_any(planner.no_go, {x, y})) {
+    throw GoalRefused("no_go", std::string(where) + " lies in a no-go zone");
+  }
   const CellIndex cell = map.index_of(x, y);
   if (!map.cell(cell)) {
     throw GoalRefused("no_data", std::string(where) +
@@ -385,12 +388,12 @@ GoalSite goal_site(const MappingPipeline& mapping, const PlannerConfig& planner,
                   planner.movable.max_step_m);
     throw GoalRefused("not_movable", where + std::string(why));
   }
-  TravelMap travel =
-      travel_map(map, movable, from, planner.movable, planner.stay_in_target ? &target : nullptr);
+  TravelMap travel = travel_map(map, movable, from, planner.movable,
+                                planner.stay_in_target ? &target : nullptr, planner.no_go);
   if (!travel.reachable(cell)) {
     throw GoalRefused("unreachable", std::string(where) +
                                          " is movable but no drive inside the target region "
-                                         "leads there from the robot");
+                                         "and around the no-go zones leads there from the robot");
   }
   const auto offset = movable.patch.offset(cell);
   const float floor_z = map.cell(cell)->patches[movable.patch.values[*offset]].mean_z;

@@ -43,7 +43,7 @@ struct LayerImage {
 };
 
 // A goal the operator asked for that the robot cannot be sent to; `code` names the reason
-// (no_map, outside_target, no_data, not_movable, unreachable).
+// (no_map, outside_target, no_go, no_data, not_movable, unreachable).
 class GoalRefused : public std::runtime_error {
  public:
   GoalRefused(std::string code_, const std::string& message)

@@ -67,6 +67,20 @@ void Mission::require_apart(const CandidateRecord& c) const {
   }
 }
 
+MissionParams Mission::set_params(const MissionParams& params, const std::string& by) {
+  map_.set_params(params);
+  const MissionParams now = map_.params();
+  const json j = params_json(now);
+  try {
+    session_.record_params(j.dump(), by);
+  } catch (const std::exception& e) {
+    // In force until a restart, which would fall back to the last ones kept.
+    spdlog::error("could not keep the parameters in the session: {}", e.what());
+  }
+  record("params", {{"by", by}, {"params", j}});
+  return now;
+}
+
 Approval Mission::approve(std::uint64_t id, const std::string& by) {
   std::lock_guard lock(mutex_);
   const PlanBook::Found found = find(id);

@@ -80,6 +80,9 @@ class Mission {
   Proposal propose(double x, double y, const std::string& robot, const std::string& by);
   // The newest `limit` recorded decisions, oldest first.
   std::vector<SessionEvent> log(std::size_t limit) const;
+  // The operator's parameters (PUT /api/v1/params): applied (the plans are made anew), kept in
+  // the session for a restart, recorded as "params" and announced to every page.
+  MissionParams set_params(const MissionParams& params, const std::string& by);
 
   // From the robots' side (the DDS thread).
   void on_status(const std::string& robot, const RobotStatus& status);

@@ -144,6 +144,19 @@ std::string mission(const json& e) {
     return "scan requested from " + str(e, "robot") + " (command " + str(e, "command_id") + ")" +
            (after.empty() ? "" : " after " + after);
   }
+  if (kind == "params") {
+    const auto p = e.find("params");
+    const auto field = [&](const char* key) {
+      return p != e.end() && p->is_object() && p->contains(key) && (*p)[key].is_array()
+                 ? (*p)[key].size()
+                 : std::size_t{0};
+    };
+    const std::size_t corners = field("target"), zones = field("no_go");
+    return "parameters set" + by(e) + ": " +
+           (corners ? "a target area of " + std::to_string(corners) + " corners"
+                    : std::string("the default target area")) +
+           ", " + std::to_string(zones) + (zones == 1 ? " no-go zone" : " no-go zones");
+  }
   json rest = e;
   rest.erase("type");
   rest.erase("at");

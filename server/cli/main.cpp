@@ -4,6 +4,7 @@
 
 #include <iostream>
 
+#include "area_command.hpp"
 #include "candidates_command.hpp"
 #include "decision_command.hpp"
 #include "register_command.hpp"
@@ -23,6 +24,7 @@ int main(int argc, char** argv) {
   // The terminal operator: a client of a running scanplan-server's REST and WebSocket API.
   scanplan::cli::add_status_command(app);
   scanplan::cli::add_candidates_command(app);
+  scanplan::cli::add_area_command(app);
   scanplan::cli::add_decision_commands(app);
   scanplan::cli::add_watch_command(app);
   try {

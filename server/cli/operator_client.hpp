@@ -25,6 +25,8 @@ class OperatorClient {
   // `body` null sends an empty body. Returns the answer's body as sent.
   std::string post(const std::string& path, const nlohmann::json& body,
                    const std::string& action) const;
+  std::string put(const std::string& path, const nlohmann::json& body,
+                  const std::string& action) const;
 
   const std::string& server() const { return http_.base(); }
   const std::string& token() const { return token_; }

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <chrono>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "app/annotations.hpp"
@@ -17,6 +18,12 @@
 namespace scanplan::server {
 
 // What the handlers work on: the application's parts, owned by main.
+namespace rest {
+// `base` with the parameters of a PUT /api/v1/params body (α, the policy, the target region,
+// the no-go zones, ...) changed; http::HttpError 400 naming the first bad one.
+MissionParams params_from(const nlohmann::json& body, MissionParams base);
+}  // namespace rest
+
 struct ApiParts {
   LiveMap& map;
   PlanBook& plans;

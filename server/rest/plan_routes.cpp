@@ -35,8 +35,6 @@ HttpError http_error(const MissionError& e) {
 
 }  // namespace rest
 
-namespace {}  // namespace
-
 Response Api::candidates(const Request& request) const {
   // One plan per robot; the newest (the robot whose scan came last) first.
   std::vector<PlanRecord> plans;
@@ -139,19 +137,44 @@ Response Api::decisions(const Request& request) const {
   }
 }
 
+namespace {
+
+// More zones than an operator draws by hand; each is checked against every candidate cell.
+constexpr std::size_t kMaxNoGoZones = 100;
+
+// A polygon [[x, y], ...] of the request, `what` naming it in the error.
+TargetRegion region_from(const json& value, const std::string& what) {
+  std::vector<Eigen::Vector2d> corners;
+  if (value.is_array()) {
+    for (const auto& c : value) {
+      if (!c.is_array() || c.size() != 2 || !c[0].is_number() || !c[1].is_number() ||
+          std::abs(c[0].get<double>()) > rest::kMaxCoordinateM ||
+          std::abs(c[1].get<double>()) > rest::kMaxCoordinateM) {
+        throw HttpError(400, "bad_request",
+                        what + " must be [[x, y], ...]: corners of finite metres within ±" +
+                            std::to_string(static_cast<long>(rest::kMaxCoordinateM)) + ", got " +
+                            c.dump().substr(0, 80));
+      }
+      corners.emplace_back(c[0].get<double>(), c[1].get<double>());
+    }
+  }
+  try {
+    return TargetRegion::polygon(corners);
+  } catch (const std::invalid_argument& e) {
+    throw HttpError(400, "bad_request",
+                    what + " is not a region the planner can take: " + e.what());
+  }
+}
+
+}  // namespace
+
 Response Api::get_params() const {
   return Response::json(200, params_json(app_.map.params()));
 }
 
-Response Api::put_params(const Request& request) {
-  json body;
-  try {
-    body = json::parse(request.body);
-  } catch (const json::exception&) {
-    throw HttpError(400, "bad_request", "the body must be a JSON object of parameters");
-  }
-  if (!body.is_object()) throw HttpError(400, "bad_request", "the body must be a JSON object");
-  MissionParams p = app_.map.params();
+namespace rest {
+
+MissionParams params_from(const json& body, MissionParams p) {
   for (const auto& [key, value] : body.items()) {
     if (key == "alpha") {
       p.planner.alpha = rest::number_in(body, "alpha", 0, 1);
@@ -173,34 +196,43 @@ Response Api::put_params(const Request& request) {
     } else if (key == "max_step_m") {
       p.planner.movable.max_step_m = rest::number_in(body, "max_step_m", 0.01, 2);
     } else if (key == "target") {
-      std::vector<Eigen::Vector2d> corners;
-      if (value.is_array()) {
-        for (const auto& c : value) {
-          if (!c.is_array() || c.size() != 2 || !c[0].is_number() || !c[1].is_number() ||
-              std::abs(c[0].get<double>()) > rest::kMaxCoordinateM ||
-              std::abs(c[1].get<double>()) > rest::kMaxCoordinateM) {
-            throw HttpError(400, "bad_request",
-                            "'target' must be [[x, y], ...]: corners of finite metres within ±" +
-                                std::to_string(static_cast<long>(rest::kMaxCoordinateM)) +
-                                ", got " + c.dump().substr(0, 80));
-          }
-          corners.emplace_back(c[0].get<double>(), c[1].get<double>());
-        }
-      }
-      try {
-        p.target = TargetRegion::polygon(corners);
-      } catch (const std::invalid_argument& e) {
+      p.target = region_from(value, "'target'");
+    } else if (key == "no_go") {
+      if (!value.is_array() || value.size() > kMaxNoGoZones) {
         throw HttpError(400, "bad_request",
-                        std::string("'target' is not a region the planner can take: ") + e.what());
+                        "'no_go' must be a list of at most " + std::to_string(kMaxNoGoZones) +
+                            " polygons [[[x, y], ...], ...] ([] for none)");
+      }
+      p.planner.no_go.clear();
+      for (std::size_t i = 0; i < value.size(); ++i) {
+        p.planner.no_go.push_back(region_from(value[i], "no-go zone " + std::to_string(i + 1)));
       }
     } else {
       throw HttpError(400, "bad_request", "unknown parameter '" + key + "'");
     }
   }
+  return p;
+}
+
+}  // namespace rest
+
+Response Api::put_params(const Request& request) {
+  json body;
+  try {
+    body = json::parse(request.body);
+  } catch (const json::exception&) {
+    throw HttpError(400, "bad_request", "the body must be a JSON object of parameters");
+  }
+  if (!body.is_object()) throw HttpError(400, "bad_request", "the body must be a JSON object");
+  std::string by = "operator";
+  if (body.contains("by")) {
+    by = rest::author_of(body);
+    body.erase("by");
+  }
+  const MissionParams p = rest::params_from(body, app_.map.params());
   // Every value is checked above, so a failure here is the machine's (memory); set_params then
   // leaves the parameters as they were.
-  app_.map.set_params(p);
-  return Response::json(200, params_json(app_.map.params()));
+  return Response::json(200, params_json(app_.mission.set_params(p, by)));
 }
 
 }  // namespace scanplan::server

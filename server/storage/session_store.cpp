@@ -268,6 +268,10 @@ SessionStore::SessionStore(std::filesystem::path dir) : dir_(created(std::move(d
       "NULL REFERENCES scans(id), x REAL NOT NULL, y REAL NOT NULL, z REAL NOT NULL, roll REAL "
       "NOT NULL, pitch REAL NOT NULL, yaw REAL NOT NULL, in_map INTEGER NOT NULL, at TEXT NOT "
       "NULL, PRIMARY KEY(revision, scan_id))");
+  // Every change of the mission's parameters, in order: the latest row is in force.
+  exec(
+      "CREATE TABLE IF NOT EXISTS params(id INTEGER PRIMARY KEY, json TEXT NOT NULL, actor TEXT "
+      "NOT NULL, at TEXT NOT NULL)");
   // Every exclusion and restoration, in order: the latest row per scan is its state.
   exec(
       "CREATE TABLE IF NOT EXISTS exclusions(id INTEGER PRIMARY KEY, scan_id INTEGER NOT NULL "
@@ -532,6 +536,20 @@ std::int64_t SessionStore::append_event(const std::string& kind, const std::stri
   s.bind(1, utc_now()).bind(2, kind).bind(3, json);
   s.step();
   return sqlite3_last_insert_rowid(db_);
+}
+
+void SessionStore::record_params(const std::string& json, const std::string& by) {
+  std::lock_guard lock(mutex_);
+  Statement s(db_, "INSERT INTO params(json, actor, at) VALUES(?, ?, ?)");
+  s.bind(1, json).bind(2, by).bind(3, utc_now());
+  s.step();
+}
+
+std::optional<std::string> SessionStore::latest_params() const {
+  std::lock_guard lock(mutex_);
+  Statement s(db_, "SELECT json FROM params ORDER BY id DESC LIMIT 1");
+  if (!s.step()) return std::nullopt;
+  return s.text(0);
 }
 
 Annotation SessionStore::add_annotation(const std::string& kind, double x, double y, double z,

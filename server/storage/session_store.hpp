@@ -144,6 +144,12 @@ class SessionStore {
   // A key-value record of what happened (decisions, events), in order, as JSON text.
   std::int64_t append_event(const std::string& kind, const std::string& json);
 
+  // The mission's parameters as the operator last set them (PUT /api/v1/params: α, the policy,
+  // the target region, the no-go zones), as JSON text, with who set them; every change is
+  // kept. latest_params() is what a restarted server resumes with; nothing before the first.
+  void record_params(const std::string& json, const std::string& by);
+  std::optional<std::string> latest_params() const;
+
   // Stores a new annotation, committed (on disk) when this returns, and returns it with its id
   // and creation time. Ids are never reused, even after a deletion. Throws SessionStoreError for
   // an unknown kind, a non-finite coordinate or a text or author over the limits, so nothing

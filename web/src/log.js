@@ -32,6 +32,13 @@ function mapCorrected(e) {
   return `map corrected: ${parts.join('; ')}`;
 }
 
+function paramsChanged(e) {
+  const p = e.params ?? {};
+  const zones = p.no_go?.length ?? 0;
+  const area = p.target ? `area of ${p.target.length} corners` : 'default area';
+  return `${e.by ?? 'operator'} set the mission's parameters: ${area}, ${zones} no-go zone${zones === 1 ? '' : 's'}, α ${p.alpha}`;
+}
+
 function describe(e) {
   const who = e.candidate != null ? `#${e.candidate}` : '';
   switch (e.kind) {
@@ -63,6 +70,8 @@ function describe(e) {
       return mapCorrected(e);
     case 'goal':
       return `proposed custom point ${who} at (${f1(e.x)}, ${f1(e.y)}), F ${Math.round(e.f ?? 0)}`;
+    case 'params':
+      return paramsChanged(e);
     default:
       return e.kind;
   }

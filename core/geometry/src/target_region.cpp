@@ -62,6 +62,11 @@ bool TargetRegion::contains(double x, double y) const {
   return polygon_contains(corners_, x, y);
 }
 
+bool in_any(const std::vector<TargetRegion>& regions, const Eigen::Vector2d& xy) {
+  return std::any_of(regions.begin(), regions.end(),
+                     [&](const TargetRegion& r) { return r.contains(xy.x(), xy.y()); });
+}
+
 double TargetRegion::area_m2() const {
   double twice = 0;
   for (std::size_t i = 0, j = corners_.size() - 1; i < corners_.size(); j = i++) {

@@ -161,7 +161,8 @@ std::vector<KeepOut> keep_outs(const PlanInput& in, const PlannerConfig& cfg) {
 }
 
 Sites collect_sites(const MlsMap& map, const MovableRegion& movable, const TravelMap& travel,
-                    const TargetRegion* within, const std::vector<KeepOut>& keep_out) {
+                    const TargetRegion* within, const std::vector<TargetRegion>& no_go,
+                    const std::vector<KeepOut>& keep_out) {
   Sites s;
   const auto& g = movable.patch;
   s.index = CellGrid<std::int32_t>(g.origin, g.cols, g.rows, g.cell_m, -1);
@@ -173,6 +174,7 @@ Sites collect_sites(const MlsMap& map, const MovableRegion& movable, const Trave
     // The robot may start outside the target region, but it scans only inside.
     const Eigen::Vector2d centre = map.center_of(c);
     if (within && !within->contains(centre.x(), centre.y())) continue;
+    if (in_any(no_go, centre)) continue;
     // Another robot is going there, or standing there.
     if (std::any_of(keep_out.begin(), keep_out.end(), [&](const KeepOut& k) {
           return (k.centre - centre).squaredNorm() < k.radius2;
@@ -652,9 +654,9 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
     return finish();
 
   const TravelMap travel = travel_map(in.map, plan.movable, start, cfg.movable,
-                                      cfg.stay_in_target ? &in.target : nullptr);
+                                      cfg.stay_in_target ? &in.target : nullptr, cfg.no_go);
   Sites sites = collect_sites(in.map, plan.movable, travel,
-                              cfg.stay_in_target ? &in.target : nullptr, keep_out);
+                              cfg.stay_in_target ? &in.target : nullptr, cfg.no_go, keep_out);
   forecast_drives(sites, in.drift, cfg.registrability);
   if (sites.size() == 0) return finish();
   // With claims, F is taken against the segmentation as it will be after the other robots'

@@ -29,7 +29,8 @@ std::vector<Eigen::Vector2d> TravelMap::path_to(CellIndex c) const {
 }
 
 TravelMap travel_map(const MlsMap& map, const MovableRegion& movable, const Eigen::Vector3d& robot,
-                     const MovableConfig& config, const TargetRegion* within) {
+                     const MovableConfig& config, const TargetRegion* within,
+                     const std::vector<TargetRegion>& avoid) {
   const auto& grid = movable.patch;
   const float inf = std::numeric_limits<float>::infinity();
   TravelMap t;
@@ -42,10 +43,9 @@ TravelMap travel_map(const MlsMap& map, const MovableRegion& movable, const Eige
   for (std::size_t o = 0; o < grid.values.size(); ++o) {
     if (grid.values[o] < 0) continue;
     const CellIndex c = grid.index_at(o);
-    if (within) {
-      const Eigen::Vector2d centre = map.center_of(c);
-      if (!within->contains(centre.x(), centre.y())) continue;
-    }
+    const Eigen::Vector2d centre = map.center_of(c);
+    if (within && !within->contains(centre.x(), centre.y())) continue;
+    if (in_any(avoid, centre)) continue;
     floor[o] = map.cell(c)->patches[grid.values[o]].max_z;
   }
 

@@ -448,6 +448,29 @@ TEST_F(WallYard, NoCandidateWhereAnotherRobotStands) {
   EXPECT_THROW(plan_next_scan(in, cfg), std::invalid_argument);
 }
 
+TEST_F(WallYard, NoCandidateOrDriveInANoGoZone) {
+  // The operator closes the ground around the wall's north end, where the best points lie, and
+  // a strip south of the robot that drives around the wall's south end would cross.
+  const TargetRegion north = TargetRegion::rectangle({44, 28}, {62, 40});
+  const TargetRegion south = TargetRegion::rectangle({30, 0}, {70, 12});
+  for (const PlannerPolicy p : {PlannerPolicy::kPaper, PlannerPolicy::kExhaustive}) {
+    PlannerConfig cfg;
+    cfg.policy = p;
+    cfg.no_go = {north, south};
+    const Plan plan = plan_next_scan(input(), cfg);
+    ASSERT_FALSE(plan.ranked.empty()) << policy_name(p);
+    for (const Candidate& c : plan.ranked) {
+      EXPECT_FALSE(in_any(cfg.no_go, c.position.head<2>()))
+          << policy_name(p) << " " << c.position.transpose();
+      ASSERT_FALSE(c.path.empty());
+      for (const Eigen::Vector2d& at : c.path) {
+        EXPECT_FALSE(in_any(cfg.no_go, at))
+            << policy_name(p) << " drives through " << at.transpose();
+      }
+    }
+  }
+}
+
 TEST_F(WallYard, ANonFiniteClaimIsRefused) {
   const std::vector<Eigen::Vector3d> claimed = {{std::nan(""), 1, 0}};
   PlanInput in = input();

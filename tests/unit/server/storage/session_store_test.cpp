@@ -182,6 +182,18 @@ TEST_F(SessionDir, EventsReadBackNewestLimitOldestFirst) {
   EXPECT_EQ(last[1].kind, "approve");
 }
 
+TEST_F(SessionDir, TheLatestParametersSurviveReopening) {
+  {
+    SessionStore s(dir_);
+    EXPECT_FALSE(s.latest_params());
+    s.record_params(R"({"alpha":0.5,"no_go":[]})", "operator");
+    s.record_params(R"({"alpha":0.7,"no_go":[[[0,0],[1,0],[1,1]]]})", "operator Ann");
+  }
+  SessionStore s(dir_);
+  EXPECT_EQ(s.latest_params(),
+            std::optional<std::string>(R"({"alpha":0.7,"no_go":[[[0,0],[1,0],[1,1]]]})"));
+}
+
 TEST_F(SessionDir, PartialWritesFromACrashAreDiscardedAndWholeFilesSetAside) {
   {
     SessionStore first(dir_);

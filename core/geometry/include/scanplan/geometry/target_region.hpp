@@ -36,4 +36,7 @@ class TargetRegion {
   Eigen::Vector2d min_, max_;
 };
 
+// Whether (x, y) lies in one of `regions` (the operator's no-go zones).
+bool in_any(const std::vector<TargetRegion>& regions, const Eigen::Vector2d& xy);
+
 }  // namespace scanplan

@@ -49,6 +49,9 @@ struct PlannerConfig {
   // that completes more ground goes first.
   double completion_weight = 0.05;
   int max_candidates = 5;  // ranked list length
+  // The operator's no-go zones (a collapse, a fire, a fuel spill): no candidate lies in one and
+  // no drive to a candidate crosses one. What lies in them is still mapped from outside.
+  std::vector<TargetRegion> no_go;
   // travel: score = F − travel_cost_per_m · F_best · max(0, drive − travel_free_m), where
   // F_best is the best F of the policy's first look over the region (its lattice sample).
   // Scans within travel_free_m of driving compete on F alone, as in `paper`; what the trade
