@@ -468,6 +468,17 @@ void LiveMap::set_params(const MissionParams& params) {
   }
 }
 
+LiveMap::Held LiveMap::held() const {
+  std::lock_guard lock(mutex_);
+  Held h;
+  for (std::size_t i = 0; i < scans_.size(); ++i) {
+    if (!in_map_[i]) continue;
+    h.scans.push_back(scans_[i]);
+    h.parts.push_back({static_cast<std::uint32_t>(scans_[i].id), placed_[i]});
+  }
+  return h;
+}
+
 std::vector<StoredScan> LiveMap::scans() const {
   std::lock_guard lock(mutex_);
   return scans_;

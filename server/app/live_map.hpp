@@ -18,6 +18,7 @@
 #include "scanplan/geometry/point_cloud.hpp"
 #include "scanplan/geometry/pose.hpp"
 #include "scanplan/geometry/voxel_filter.hpp"
+#include "scanplan/io/map_export.hpp"
 #include "scanplan/mission/mission_pipeline.hpp"
 #include "scanplan/planning/scan_planner.hpp"
 #include "storage/session_store.hpp"
@@ -132,6 +133,13 @@ class LiveMap {
   std::vector<StoredScan> scans() const;
   // The scans waiting outside the map for a match that ties them in, ascending.
   std::vector<std::int64_t> waiting() const;
+  // What the map holds (the scans not waiting outside it), each scan's points in the map frame
+  // as drawn, with its stored record: what the exports write.
+  struct Held {
+    std::vector<StoredScan> scans;
+    std::vector<MapPart> parts;
+  };
+  Held held() const;
   // Where a new scan of `robot` goes: matched against the map so far (MissionPipeline::place;
   // with drifting odometry from the robot's latest placed scan). Nothing when matching is off
   // or the map is empty. Call from the thread that calls add().

@@ -69,6 +69,8 @@ class Api {
   http::Response decisions(const http::Request& request) const;
   http::Response decide(const http::Request& request, const std::string& id,
                         const std::string& action);
+  // GET /api/v1/export/{map.ply,map.las,poses.csv,annotations.geojson}.
+  http::Response export_file(const std::string& name) const;
   http::Response list_annotations() const;
   http::Response post_annotation(const http::Request& request);
   http::Response delete_annotation(const http::Request& request, const std::string& id);
