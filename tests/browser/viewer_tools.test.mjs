@@ -6,6 +6,7 @@
 // a robot whose bridge dies shows as lost.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
+import { readFileSync, statSync } from 'node:fs';
 import { scanAndWait, startStack } from '../support/stack.mjs';
 import { canvasCoverage, dataset, frames, openPage, screenshot, waitForData, withBrowser } from '../support/browser.mjs';
 
@@ -63,6 +64,25 @@ test('a viewer sees the map and the plan but no action buttons', { timeout: 6000
     assert.ok(await page.locator('#goal-propose').isHidden(), 'viewers cannot propose goals');
     t.diagnostic(`shot: ${await screenshot(page, 'viewer.png')}`);
     assert.deepEqual(problems.foreignRequests, [], 'every asset comes from our server');
+    assert.deepEqual(problems.pageErrors, []);
+    assert.deepEqual(problems.consoleErrors, []);
+  });
+});
+
+test('a viewer saves the map and the poses for other teams', { timeout: 60000 }, async () => {
+  await withBrowser(async (context) => {
+    const { page, problems } = await openPage(context, pageUrl(stack.viewerToken));
+    await loaded(page);
+    const [las] = await Promise.all([page.waitForEvent('download'), page.selectOption('#export-select', 'map.las')]);
+    assert.equal(las.suggestedFilename(), 'scanplan-map.las');
+    assert.equal(statSync(await las.path()).size, 375 + 36 * points, 'a LAS header and a record per map point');
+    await page.waitForFunction(() => document.getElementById('export-msg').dataset.state === 'saved');
+    assert.match(await page.locator('#export-msg').innerText(), /saved scanplan-map\.las \(\d+\.\d MB, map frame\)/);
+
+    const [csv] = await Promise.all([page.waitForEvent('download'), page.selectOption('#export-select', 'poses.csv')]);
+    const expected = await (await stack.api('GET', '/api/v1/export/poses.csv')).text();
+    assert.equal(readFileSync(await csv.path(), 'utf8'), expected);
+    assert.equal(await page.locator('#export-select').inputValue(), '', 'the menu is ready for the next');
     assert.deepEqual(problems.pageErrors, []);
     assert.deepEqual(problems.consoleErrors, []);
   });

@@ -9,6 +9,7 @@ import { CandidatesPanel } from './candidates.js';
 import { CoverageChart } from './chart.js';
 import { ExcludedScans } from './excluded_scans.js';
 import { EventStream, OP_MAP_CHUNK, eventsUrl } from './events.js';
+import { ExportMenu } from './exports.js';
 import { GoalPicker } from './goals.js';
 import { DecisionLog } from './log.js';
 import { MapChunks } from './map_chunks.js';
@@ -67,6 +68,8 @@ const chunks = new MapChunks({
   },
   onChange: () => render(),
 });
+new ExportMenu($('export-select'), $('export-msg'));
+
 const excluded = new ExcludedScans({
   list: $('excluded-scans'),
   onChange: () => soon(() => {
