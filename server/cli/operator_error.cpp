@@ -34,6 +34,8 @@ std::string exit_code_help() {
          "  7  server-side failure (HTTP 5xx, e.g. 503 no robot bridge connected)\n"
          "  8  declined at the confirmation prompt\n"
          "  9  request refused as malformed (HTTP 400)\n"
+         "  10 approve: the robot refused to go there\n"
+         "  11 approve: the robot did not answer within --wait\n"
          "  100 and above: command-line usage errors";
 }
 

@@ -3,7 +3,7 @@
 // one is reported on the progress topic and the bridge keeps going.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { execFileSync } from 'node:child_process';
+import { execFileSync, spawn } from 'node:child_process';
 import { mkdtempSync, writeFileSync, readFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
@@ -60,4 +60,24 @@ test('each scan command plays the next recording, skipping a broken file with a 
   const q = session.last_scan.pose;
   assert.ok(Math.hypot(q.x - 10, q.y + 15) < 0.05 && Math.abs(q.yaw_deg - 90) < 0.3, JSON.stringify(q));
   assert.equal(stack.bridge.exitCode, null, 'the bridge is still running');
+});
+
+test('approving a move the replaying robot cannot make fails with the robot\'s reason', async () => {
+  const plan = await stack.waitFor('a plan', async () => {
+    const b = await (await stack.api('GET', '/api/v1/candidates')).json();
+    return b.candidates?.length ? b : undefined;
+  });
+  const id = String(plan.candidates[0].id);
+  const result = await new Promise((resolve) => {
+    const child = spawn(requireEnv('SCANPLAN_CLI'),
+      ['approve', id, '--yes', '--wait', '20', '--server', stack.url, '--token', stack.token],
+      { stdio: ['ignore', 'pipe', 'pipe'] });
+    let stdout = '', stderr = '';
+    child.stdout.on('data', (d) => { stdout += d; });
+    child.stderr.on('data', (d) => { stderr += d; });
+    child.on('exit', (code) => resolve({ code, stdout, stderr }));
+  });
+  assert.match(result.stdout, new RegExp(`^approved candidate ${id}`));
+  assert.equal(result.code, 10, result.stderr);
+  assert.match(result.stderr, new RegExp(`robot1 refused to go to candidate ${id}: this robot replays a recording`));
 });
