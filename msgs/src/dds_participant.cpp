@@ -75,7 +75,11 @@ std::unique_ptr<dds_qos_t, QosDeleter> make_qos(QosKind kind) {
       dds_qset_resource_limits(q.get(), 64, 64, 64);
       break;
     case QosKind::kStatus:
-      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, 1);
+      // Not only the latest: the topics are keyless (one instance for every robot), and with a
+      // depth of 1 a robot's refusal followed at once by its idle heartbeat, or two robots'
+      // statuses, reached the server as the last one alone — a refused move stayed "driving"
+      // (issue 18). 64 samples are a minute of heartbeats from a dozen robots.
+      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, 64);
       // The status writer is how the server knows which robot a bridge speaks for, and its
       // lease is how it knows the bridge is still there.
       dds_qset_liveliness(q.get(), DDS_LIVELINESS_AUTOMATIC,

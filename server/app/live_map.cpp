@@ -133,6 +133,12 @@ LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
          /*whole=*/!c.joined.empty() || !c.left.empty() || c.max_moved_m > kThinnedMapVoxelM / 3);
   follow_robots(f);
   last_scan_ = {scan.id, scan.robot};
+  // The map changed around the new scan: points a robot refused there may be worth a try again
+  // (the completed radius, paper §3.3: what a scan completes).
+  if (f.in_map.back()) {
+    const Pose& at = f.scans.back().placed;
+    plans_.forget_refusals_near(at.x, at.y, mission_.planner().regions.completed_radius_m);
+  }
   Added out;
   out.corrected = f.corrected;
   out.in_map = f.in_map.back() != 0;
@@ -270,7 +276,9 @@ std::vector<PlanRecord> LiveMap::make_plans() const {
   for (const auto& [robot, goal] : driving) claims.push_back(goal);
   std::vector<FleetRobot> robots;
   for (const auto& [robot, at] : scan_pose_of_) {
-    if (!driving.count(robot)) robots.push_back({robot, {at.x, at.y, at.z}, {}});
+    if (!driving.count(robot)) {
+      robots.push_back({robot, {at.x, at.y, at.z}, {}, plans_.refused_points(robot)});
+    }
   }
   const PlannerConfig& planner = mission_.planner();
   std::vector<PlanRecord> records;

@@ -77,6 +77,8 @@ bool PlanBook::set_candidate_state(std::uint64_t id, CandidateState state,
       if (c.id != id) continue;
       c.state = state;
       c.note = note;
+      if (state == CandidateState::kRefused)
+        refused_[robot].push_back(c.candidate.position.head<2>());
       if (state == CandidateState::kReached) {
         reached_[robot] = c.candidate.position;
       } else if (state != CandidateState::kRejected) {
@@ -86,6 +88,20 @@ bool PlanBook::set_candidate_state(std::uint64_t id, CandidateState state,
     }
   }
   return false;
+}
+
+std::vector<Eigen::Vector2d> PlanBook::refused_points(const std::string& robot) const {
+  std::lock_guard lock(mutex_);
+  const auto it = refused_.find(robot);
+  return it == refused_.end() ? std::vector<Eigen::Vector2d>{} : it->second;
+}
+
+void PlanBook::forget_refusals_near(double x, double y, double radius_m) {
+  std::lock_guard lock(mutex_);
+  const Eigen::Vector2d at(x, y);
+  for (auto& [robot, points] : refused_) {
+    std::erase_if(points, [&](const Eigen::Vector2d& p) { return (p - at).norm() <= radius_m; });
+  }
 }
 
 std::optional<PlanBook::Found> PlanBook::find(std::uint64_t id) const {

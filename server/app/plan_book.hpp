@@ -78,11 +78,17 @@ class PlanBook {
   // Where the robots other than `robot` are going to scan next: the goals of approved moves,
   // else the best candidates of their plans.
   std::vector<Eigen::Vector3d> claims_except(const std::string& robot) const;
+  // The points `robot` refused to drive to (candidates set kRefused), which its plans leave out
+  // until the map there changes: forget_refusals_near drops those within `radius_m` of a new
+  // scan.
+  std::vector<Eigen::Vector2d> refused_points(const std::string& robot) const;
+  void forget_refusals_near(double x, double y, double radius_m);
 
  private:
   mutable std::mutex mutex_;
-  std::map<std::string, PlanRecord> plans_;         // by robot
-  std::map<std::string, Eigen::Vector3d> reached_;  // by robot: take_reached_goal
+  std::map<std::string, PlanRecord> plans_;                      // by robot
+  std::map<std::string, Eigen::Vector3d> reached_;               // by robot: take_reached_goal
+  std::map<std::string, std::vector<Eigen::Vector2d>> refused_;  // by robot
   std::string latest_robot_;
   std::atomic<std::uint64_t> next_plan_id_{1}, next_candidate_id_{1};
 };

@@ -77,6 +77,15 @@ export class CandidatesPanel {
       this.selected = null;
       this.message = ''; // it was about a candidate of an older plan
     }
+    // "On its way" holds while the move does: a refusal or an arrival says otherwise.
+    const now = this.list.find((c) => c.id === this.selected);
+    if (this.messageState && now && now.state !== this.messageState) {
+      this.messageState = null;
+      this.message = now.state === 'refused'
+        ? `refused by ${now.robot || this.plan?.robot || 'the robot'}${now.note ? `: ${now.note}` : ''}`
+        : '';
+      this.messageIsError = now.state === 'refused';
+    }
     if (this.selected == null) {
       // Keep the eye on what matters: a move under way, else the best proposal.
       const moving = this.list.find((c) => c.state === 'moving' || c.state === 'interrupted');
@@ -89,6 +98,7 @@ export class CandidatesPanel {
   select(id) {
     this.selected = id;
     this.message = '';
+    this.messageState = null;
     this.render();
     this.onSelect(id);
   }
@@ -153,6 +163,16 @@ export class CandidatesPanel {
       list.append(row);
     }
 
+    // Nothing left to send the robot to: every point was refused (or rejected). The server
+    // leaves refused points out of the next plans until the map there changes.
+    const closed = (c) => c.state === 'refused' || c.state === 'rejected';
+    if (this.list.length && this.list.every(closed) && this.list.some((c) => c.state === 'refused')) {
+      const robots = [...new Set(this.list.filter((c) => c.state === 'refused').map((c) => c.robot || this.plan?.robot || 'the robot'))];
+      list.prepend(el('div', 'all-refused',
+        `${robots.join(', ')} refused every suggested point. Click a spot on the top view to propose your own, ` +
+        'or ask for a scan where the robot stands; refused points are not suggested again until the map there changes.'));
+    }
+
     detail.replaceChildren();
     const c = this.current;
     if (!c) {
@@ -211,6 +231,7 @@ export class CandidatesPanel {
       await sendJson(`/api/v1/candidates/${c.id}/${action}`, body);
       this.busy = false;
       const done = { approve: 'approved: the robot is on its way', reject: 'rejected', cancel: 'move stopped' }[action];
+      this.messageState = action === 'approve' ? 'moving' : null;
       this._say(done);
       this.onChanged();
     } catch (e) {

@@ -30,6 +30,7 @@ std::vector<FleetPlan> plan_fleet(const MlsMap& map, const TargetRegion& target,
       in.occupied = &others;
       in.anchored = anchored;
       in.drift = r.drift ? &*r.drift : nullptr;
+      in.refused = &r.refused;
       plans.push_back(plan_next_scan(in, cfg));
     }
     // The highest best score; then, among those close to it, the shortest drive.

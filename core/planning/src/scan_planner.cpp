@@ -67,6 +67,7 @@ void check_config(const PlannerConfig& c) {
   if (!(c.candidate_separation_m >= 0)) fail("candidate_separation_m must be zero or more");
   if (!(c.claim_separation_m >= 0)) fail("claim_separation_m must be zero or more");
   if (!(c.robot_clearance_m >= 0)) fail("robot_clearance_m must be zero or more");
+  if (!(c.refused_clearance_m >= 0)) fail("refused_clearance_m must be zero or more");
   if (!std::isfinite(c.min_gain_m2)) fail("min_gain_m2 must be finite");
   if (c.threads < 0) fail("threads must be zero (OpenMP default) or more");
   const RegistrabilityConfig& r = c.registrability;
@@ -156,6 +157,13 @@ std::vector<KeepOut> keep_outs(const PlanInput& in, const PlannerConfig& cfg) {
   for (const Eigen::Vector3d& r :
        points_of(in.occupied, "another robot's position is not finite")) {
     out.push_back({r.head<2>(), cfg.robot_clearance_m * cfg.robot_clearance_m});
+  }
+  if (in.refused) {
+    for (const Eigen::Vector2d& r : *in.refused) {
+      if (!r.allFinite())
+        throw std::invalid_argument("plan_next_scan: a refused point is not finite");
+      out.push_back({r, cfg.refused_clearance_m * cfg.refused_clearance_m});
+    }
   }
   return out;
 }

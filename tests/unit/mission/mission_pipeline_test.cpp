@@ -216,7 +216,7 @@ TEST_F(MissionPipelineTest, PlansTheNextScanInsideTheMovableRegion) {
     EXPECT_TRUE(m.movable()->contains(m.map().index_of(c.position.x(), c.position.y())));
   }
   // Two robots on one map: one plan each, and not the same best point.
-  const auto plans = mission.plan({{"a", {-15, -8, 0}, {}}, {"b", {-20, 5, 0}, {}}});
+  const auto plans = mission.plan({{"a", {-15, -8, 0}, {}, {}}, {"b", {-20, 5, 0}, {}, {}}});
   ASSERT_EQ(plans.size(), 2u);
   ASSERT_FALSE(plans[0].plan.ranked.empty());
   ASSERT_FALSE(plans[1].plan.ranked.empty());

@@ -376,7 +376,7 @@ TEST_F(WallYard, AClaimedScanPointSendsTheNextRobotElsewhere) {
 // Two robots on one map: the spot past the wall goes to the robot nearer it, whichever is listed
 // first, and the other is sent at least claim_separation_m away.
 TEST_F(WallYard, TheFleetGivesTheBestSpotToTheNearerRobot) {
-  const FleetRobot far{"far", {40, 20, 0}, {}}, near{"near", {47, 30, 0}, {}};
+  const FleetRobot far{"far", {40, 20, 0}, {}, {}}, near{"near", {47, 30, 0}, {}, {}};
   PlannerConfig cfg;
   cfg.policy = PlannerPolicy::kExhaustive;
   const double alone = plan(PlannerPolicy::kExhaustive, 0.5).ranked.front().f;
@@ -469,6 +469,23 @@ TEST_F(WallYard, NoCandidateOrDriveInANoGoZone) {
       }
     }
   }
+}
+
+TEST_F(WallYard, NoCandidateNearAPointTheRobotRefused) {
+  PlannerConfig cfg;
+  cfg.policy = PlannerPolicy::kExhaustive;
+  const Candidate best = plan_next_scan(input(), cfg).ranked.front();
+  const std::vector<Eigen::Vector2d> refused = {best.position.head<2>()};
+  PlanInput in = input();
+  in.refused = &refused;
+  const Plan plan = plan_next_scan(in, cfg);
+  ASSERT_FALSE(plan.ranked.empty());
+  for (const Candidate& c : plan.ranked) {
+    EXPECT_GE((c.position.head<2>() - refused[0]).norm(), cfg.refused_clearance_m);
+  }
+  const std::vector<Eigen::Vector2d> nowhere = {{std::nan(""), 0}};
+  in.refused = &nowhere;
+  EXPECT_THROW(plan_next_scan(in, cfg), std::invalid_argument);
 }
 
 TEST_F(WallYard, ANonFiniteClaimIsRefused) {

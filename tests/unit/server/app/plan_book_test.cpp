@@ -82,6 +82,25 @@ TEST(PlanBook, ARobotThatReachedItsGoalWasSentThereForItsNextScanOnly) {
   }
 }
 
+TEST(PlanBook, ARefusedPointIsKeptForItsRobotUntilAScanNearItChangesTheMap) {
+  PlanBook book;
+  book.replace({{1, 1, "a", "paper", 0.5, 1, {at(1, 1, 10), at(2, 2, 50)}},
+                {2, 1, "b", "paper", 0.5, 1, {at(3, 1, 90)}}},
+               "a");
+  book.set_candidate_state(1, CandidateState::kMoving);
+  book.set_candidate_state(1, CandidateState::kRefused, "the goal lies outside the target region");
+  book.set_candidate_state(2, CandidateState::kRejected, "rubble");  // the operator's, not a refusal
+  ASSERT_EQ(book.refused_points("a").size(), 1u);
+  EXPECT_EQ(book.refused_points("a")[0], Eigen::Vector2d(10, 0));
+  EXPECT_TRUE(book.refused_points("b").empty()) << "robot b may still go there";
+  // A new plan does not forget it; a scan farther than the radius does not either.
+  book.replace({{3, 2, "a", "paper", 0.5, 1, {at(4, 1, 60)}}}, "a");
+  book.forget_refusals_near(40, 0, 20);
+  EXPECT_EQ(book.refused_points("a").size(), 1u);
+  book.forget_refusals_near(25, 0, 20);
+  EXPECT_TRUE(book.refused_points("a").empty());
+}
+
 TEST(PlanBook, IdsAreUniqueAcrossPlans) {
   PlanBook book;
   EXPECT_EQ(book.new_plan_id(), 1u);

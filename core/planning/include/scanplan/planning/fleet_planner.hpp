@@ -13,7 +13,8 @@ namespace scanplan {
 struct FleetRobot {
   std::string id;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  std::optional<DriveDrift> drift;  // PlanInput::drift
+  std::optional<DriveDrift> drift;       // PlanInput::drift
+  std::vector<Eigen::Vector2d> refused;  // PlanInput::refused
 };
 
 struct FleetPlan {

@@ -74,6 +74,9 @@ struct PlannerConfig {
   // ...and none this close to where another robot stands (PlanInput::occupied): a robot's
   // footprint with a margin.
   double robot_clearance_m = 2.0;
+  // ...and none this close to a point the robot refused (PlanInput::refused): the same place, as
+  // the ranked list's candidate_separation_m counts places.
+  double refused_clearance_m = 5.0;
   // Several robots (plan_fleet): best candidates scoring within this share of the highest
   // count as equally good, and the robot with the shortest drive to its own takes it.
   double fleet_tie_share = 0.02;
@@ -122,6 +125,9 @@ struct PlanInput {
   const std::vector<Eigen::Vector3d>* claimed = nullptr;
   // Where the other robots stand now (x, y, floor z): no candidate within robot_clearance_m.
   const std::vector<Eigen::Vector3d>* occupied = nullptr;
+  // Points this robot refused to drive to (x, y): no candidate within refused_clearance_m, until
+  // the map there changes (the caller forgets them then).
+  const std::vector<Eigen::Vector2d>* refused = nullptr;
   // The part of `map` the scan matcher matches against (the anchored scans; MissionPipeline),
   // on the same cells: candidates are forecast against it (PlannerConfig::registrability).
   // Null: no forecast (matching off, or a tool with one map).

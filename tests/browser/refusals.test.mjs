@@ -1,0 +1,54 @@
+// A robot that refuses every point (a bridge replaying a recording cannot drive): the operator
+// approves the suggestions one after another from the page, each comes back refused with the
+// robot's reason, and once none is left the page says so and points to the operator's own point.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
+import { mkdtempSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { scanAndWait, startStack, requireEnv } from '../support/stack.mjs';
+import { openPage, screenshot, waitForData, withBrowser } from '../support/browser.mjs';
+
+let stack;
+before(async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'scanplan-refusals-'));
+  execFileSync(requireEnv('SCANPLAN_CLI'), ['scan', '--world', join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples/worlds/yard.json'),
+    '--at', '-15,-8,0,0', '--out', join(dir, 'scan0.ply'), '--seed', '1'], { stdio: 'ignore' });
+  writeFileSync(join(dir, 'poses.csv'), 'file,x,y,z,yaw_deg\nscan0.ply,-15,-8,0,0\n');
+  stack = await startStack({ replay: dir });
+  await scanAndWait(stack, 1);
+});
+after(async () => stack && (await stack.stop()));
+
+test('every suggestion refused: the page says so and offers the operator\'s own point', { timeout: 90000 }, async (t) => {
+  await withBrowser(async (context) => {
+    const { page, problems } = await openPage(context, `${stack.url}/?token=${encodeURIComponent(stack.token)}`);
+    await waitForData(page, 'candidates', () => Number(document.body.dataset.candidates) >= 1);
+    const count = await page.locator('#cand-list .cand-row').count();
+    assert.ok(count >= 2, `${count} candidates`);
+    assert.equal(await page.locator('.all-refused').count(), 0, 'nothing refused yet');
+    for (let k = 0; k < count; k++) {
+      const row = page.locator('#cand-list .cand-row[data-state="proposed"]').first();
+      const id = await row.getAttribute('data-id');
+      await row.click();
+      await page.locator('#approve').click();
+      await page.waitForSelector('#confirm[open]');
+      await page.locator('#confirm-ok').click();
+      await page.waitForFunction((cid) => document.querySelector(`#cand-list .cand-row[data-id="${cid}"]`)?.dataset.state === 'refused', id, { timeout: 15000 })
+        .catch(async (e) => {
+          const server = await (await stack.api('GET', '/api/v1/candidates')).json();
+          const states = await page.evaluate(() => [...document.querySelectorAll('#cand-list .cand-row')].map((r) => `${r.dataset.id}:${r.dataset.state}`));
+          throw new Error(`candidate ${id} not shown refused: page ${states}, server ${server.candidates.map((c) => `${c.id}:${c.state}`)}, ${await page.locator('#cand-detail').innerText()} (${e.message})`);
+        });
+    }
+    // The selected candidate's panel follows its state: not "on its way" once refused.
+    assert.match(await page.locator('#cand-detail').innerText(), /refused by robot1: this robot replays a recording/);
+    assert.doesNotMatch(await page.locator('#cand-detail').innerText(), /on its way/);
+    assert.ok(await page.locator('.all-refused').isVisible(), 'the hint is in view, above the list');
+    const text = await page.locator('.all-refused').innerText();
+    assert.match(text, /robot1 refused every suggested point\. Click a spot on the top view to propose your own/);
+    t.diagnostic(`shot: ${await screenshot(page, 'all-refused.png')}`);
+    assert.deepEqual(problems.pageErrors, []);
+  });
+});
