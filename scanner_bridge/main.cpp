@@ -31,6 +31,9 @@ bool can_stand_at_start(const scanplan::World& world) {
   return std::any_of(surfaces.begin(), surfaces.end(),
                      [&](float z) { return std::abs(z - world.start.z) < 0.3; });
 }
+// A replayed scan "takes" 3 s instead of the scanner's 60.
+constexpr double kReplayTimeScale = 20.0;
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -44,10 +47,11 @@ int main(int argc, char** argv) {
   app.add_option("--domain", domain, "DDS domain id")->capture_default_str();
   app.add_option("--robot-id", options.robot_id, "robot id, first part of every frame_id")
       ->capture_default_str();
-  app.add_option("--time-scale", options.time_scale,
-                 "simulated seconds per real second (a scan takes 60 s simulated; 0: no waiting)")
-      ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+  auto* scale_opt =
+      app.add_option("--time-scale", options.time_scale,
+                     "simulated seconds per real second (a scan takes 60 s simulated; 0: no "
+                     "waiting); default 1 for --world, 20 for --replay (3 s a recorded scan)")
+          ->check(CLI::NonNegativeNumber);
   app.add_option("--seed", options.seed, "seed for range and pose noise")->capture_default_str();
   std::vector<double> start;
   auto* start_opt = app.add_option("--start", start,
@@ -92,6 +96,9 @@ int main(int argc, char** argv) {
       scanplan::bridge::SimulatedRobot robot(std::move(world), participant, options);
       robot.run(g_stop);
     } else {
+      // A recording was taken already: waiting a minute for each scan again only keeps the
+      // operator from looking at it (issue 18).
+      if (scale_opt->count() == 0) options.time_scale = kReplayTimeScale;
       scanplan::bridge::ReplayOptions replay{options.robot_id, options.time_scale};
       scanplan::bridge::ReplayRobot robot(scanplan::ReplayFolder(replay_dir), participant, replay);
       robot.run(g_stop);

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <thread>
 
 #include "scanplan/io/image_codec.hpp"
@@ -22,15 +23,22 @@ SimulatedRobot::SimulatedRobot(World world, dds::Participant& participant, Bridg
                                                world_.start.yaw)),
       odometry_(world_.pose_noise, true_pose_, options_.seed) {}
 
-bool SimulatedRobot::pass_time(double simulated_s, const std::atomic<bool>& stop) const {
+bool SimulatedRobot::pass_time(double simulated_s, const std::atomic<bool>& stop,
+                               const std::function<void(double share)>& tick) const {
   if (options_.time_scale <= 0) return !stop;
   using Clock = std::chrono::steady_clock;
-  const Clock::time_point until =
-      Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                         std::chrono::duration<double>(simulated_s / options_.time_scale));
+  const Clock::time_point start = Clock::now();
+  const auto span = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(simulated_s / options_.time_scale));
+  const Clock::time_point until = start + span;
+  Clock::time_point next_tick = start + kDriveReport;
   // Short naps so that a stop request is noticed mid-drive.
   while (!stop && Clock::now() < until) {
     std::this_thread::sleep_until(std::min(until, Clock::now() + std::chrono::milliseconds(50)));
+    if (tick && Clock::now() >= next_tick && Clock::now() < until) {
+      tick(std::chrono::duration<double>(Clock::now() - start) / span);
+      next_tick += kDriveReport;
+    }
   }
   return !stop;
 }
@@ -112,7 +120,17 @@ void SimulatedRobot::move(const MoveRequest& goal, const std::atomic<bool>& stop
   spdlog::info("move command {}: driving {:.1f} m to ({:.2f}, {:.2f})", goal.command_id, distance,
                goal.x, goal.y);
   publisher_.status(goal.command_id, "moving", odometry_.reported());
-  if (!pass_time(distance / options_.speed_mps, stop)) return;
+  // On the way it reports where it is: between where its odometry had it and the goal, by the
+  // share of the drive done (the path's bends are not followed; what matters to the operator
+  // is that the distance to go shrinks).
+  const Pose from = odometry_.reported();
+  const auto report = [&](double share) {
+    Pose at = from;
+    at.x += share * (goal.x - from.x);
+    at.y += share * (goal.y - from.y);
+    publisher_.status(goal.command_id, "moving", at);
+  };
+  if (!pass_time(distance / options_.speed_mps, stop, report)) return;
   true_pose_ =
       traversability_.standing_pose(goal.x, goal.y, reach.z[*goal_cell], deg2rad(goal.yaw_deg));
   odometry_.moved(true_pose_, distance);

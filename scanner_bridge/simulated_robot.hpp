@@ -1,7 +1,9 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "command_reader.hpp"
@@ -23,6 +25,9 @@ struct BridgeOptions {
 // Stands for the scanner robot on DDS in a simulated world: scans where it truly stands
 // (publishing the pose it would report: SimulatedOdometry, drifting or absolute), and drives to
 // goals it can reach.
+// How often a driving robot reports where it is: the operator sees the distance to go shrink.
+inline constexpr std::chrono::milliseconds kDriveReport{500};
+
 class SimulatedRobot {
  public:
   SimulatedRobot(World world, dds::Participant& participant, BridgeOptions options);
@@ -32,8 +37,10 @@ class SimulatedRobot {
  private:
   void scan(std::uint32_t command_id, const std::atomic<bool>& stop);
   void move(const MoveRequest& goal, const std::atomic<bool>& stop);
-  // Sleeps for `simulated_s` of simulated time; false when stopped meanwhile.
-  bool pass_time(double simulated_s, const std::atomic<bool>& stop) const;
+  // Sleeps for `simulated_s` of simulated time; false when stopped meanwhile. `tick` is called
+  // with the share of the time passed about every kDriveReport of real time.
+  bool pass_time(double simulated_s, const std::atomic<bool>& stop,
+                 const std::function<void(double share)>& tick = {}) const;
 
   World world_;
   RayCaster caster_;

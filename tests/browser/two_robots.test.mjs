@@ -67,3 +67,43 @@ test('two robots: both plans listed by robot, each approved on its own', { timeo
     assert.deepEqual(problems, { pageErrors: [], consoleErrors: [], foreignRequests: [] }, 'no page errors, nothing from elsewhere');
   });
 });
+
+test('each robot shows its own drive and its own scan progress', { timeout: 120000 }, async () => {
+  await withBrowser(async (context) => {
+    const { page, problems } = await openPage(context, `${stack.url}/?token=${encodeURIComponent(stack.token)}`);
+    await waitForData(page, 'both plans', () =>
+      ['robot1', 'robot2'].every((r) => document.querySelector(`#cand-list .cand-row[data-robot="${r}"]`)));
+    // robot2 drives to its best point; the metres to go shrink while it does (its bridge reports
+    // where it is on the way).
+    const free = page.locator('#cand-list .cand-row[data-robot="robot2"][data-state="proposed"]').first();
+    await free.click();
+    await page.click('#approve');
+    await page.waitForSelector('#confirm[open]');
+    await page.click('#confirm-ok');
+    const seen = [];
+    const deadline = Date.now() + 30000;
+    while (Date.now() < deadline) {
+      const line = await page.evaluate(() => [...document.querySelectorAll('#robots .robot-line')]
+        .map((l) => l.innerText).find((t) => t.startsWith('robot2')) || '');
+      const m = line.match(/([\d.]+) m to go/);
+      if (m && Number(m[1]) !== seen[seen.length - 1]) seen.push(Number(m[1]));
+      if (/arrived|scanning|idle/.test(line) && seen.length) break;
+      await page.waitForTimeout(100);
+    }
+    assert.ok(seen.length >= 2, `distances to go seen: ${seen}`);
+    assert.ok(seen[seen.length - 1] < seen[0], `the distance to go shrinks: ${seen}`);
+
+    // Both robots scan at once: each line has its own progress.
+    await stack.waitFor('both robots idle', async () => {
+      const s = await (await stack.api('GET', '/api/v1/session')).json();
+      return ['robot1', 'robot2'].every((r) => ['idle', 'arrived'].includes(s.robots[r]?.state)
+        && s.robots[r]?.scan?.state !== 'scanning') || undefined;
+    });
+    await requestScan(stack);
+    await waitForData(page, 'two progress bars', () =>
+      new Set([...document.querySelectorAll('#robots .robot-progress')].map((m) => m.dataset.robot)).size === 2);
+    assert.equal(await page.locator('#scan-here').isDisabled(), true, 'no second scan request while they scan');
+    await waitForData(page, 'both scans done', () => document.querySelectorAll('#robots .robot-progress').length === 0, undefined, 60000);
+    assert.deepEqual(problems.pageErrors, []);
+  });
+});

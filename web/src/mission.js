@@ -24,7 +24,8 @@ export class MissionPanel {
     this.els = els;
     this.onChanged = onChanged;
     this.robots = {}; // id -> {state, message, pose, command_id}
-    this.scan = null; // {robot, state, fraction, message}
+    this.scan = null; // the newest scan news of any robot: {robot, state, fraction, message}
+    this.scans = {}; // robot id -> its own scan's {state, fraction, message, command_id}
     this.stage = ''; // what happens to the newest scan after it was taken
     this.match = null;
     this.matches = new Map(); // scan id -> match_done event seen by this page
@@ -55,6 +56,7 @@ export class MissionPanel {
         lostAt: r.lost_at || null,
         lostReason: r.lost_reason || '',
       };
+      if (r.scan && r.scan.state !== 'idle') this.scans[id] = { ...r.scan };
       if (r.scan && r.scan.state === 'scanning') this.scan = { robot: id, ...r.scan };
       else if (!this.scan && r.scan && r.scan.state !== 'idle') this.scan = { robot: id, ...r.scan };
     }
@@ -80,12 +82,14 @@ export class MissionPanel {
   /** scan_failed: the scan under way was lost with its bridge; nothing of it reaches the map. */
   onScanFailed(e) {
     this.scan = { robot: e.robot, state: 'failed', fraction: e.fraction ?? 0, message: e.reason || 'the scan failed', command_id: e.command_id };
+    this.scans[e.robot] = { ...this.scan };
     this.stage = '';
     this.render();
   }
 
   onScanProgress(e) {
     this.scan = { robot: e.robot, state: e.state, fraction: e.fraction, message: e.message, command_id: e.command_id };
+    this.scans[e.robot] = { ...this.scan };
     if (e.state === 'scanning') this.stage = '';
     if (e.state === 'done') this.stage = 'received by the robot; sending it to the server…';
     this.render();
@@ -188,6 +192,22 @@ export class MissionPanel {
       }
       const toGo = this.goalDistances?.[id];
       if (r.state === 'moving' && toGo != null) extra = `${toGo.toFixed(1)} m to go${extra ? ` · ${extra}` : ''}`;
+      // With several robots each shows its own scan: one robot's progress never stands for
+      // another's.
+      const own = this.scans[id];
+      if (ids.length > 1 && own && own.state === 'scanning') {
+        const p = Math.round(Math.max(0, Math.min(1, Number(own.fraction) || 0)) * 100);
+        const meter = document.createElement('span');
+        meter.className = 'robot-progress';
+        meter.dataset.robot = id;
+        meter.dataset.fraction = String(p / 100);
+        meter.title = `${id} scanning ${p} %`;
+        const fill = document.createElement('i');
+        fill.style.width = `${p}%`;
+        meter.append(fill);
+        line.append(meter);
+        extra = `scanning ${p} %${extra ? ` · ${extra}` : ''}`;
+      }
       if (extra) {
         const m = document.createElement('span');
         m.className = 'muted';
@@ -225,7 +245,8 @@ export class MissionPanel {
     }
     match.title = this.matchHistory().join('\n');
     scanHere.hidden = !this.operator;
-    scanHere.disabled = !this.bridges || (!!s && s.state === 'scanning');
+    // "Scan here" asks every robot: not while any of them is scanning.
+    scanHere.disabled = !this.bridges || Object.values(this.scans).some((x) => x.state === 'scanning');
     message.hidden = !message.textContent;
   }
 

@@ -89,7 +89,8 @@ TEST(PlanBook, ARefusedPointIsKeptForItsRobotUntilAScanNearItChangesTheMap) {
                "a");
   book.set_candidate_state(1, CandidateState::kMoving);
   book.set_candidate_state(1, CandidateState::kRefused, "the goal lies outside the target region");
-  book.set_candidate_state(2, CandidateState::kRejected, "rubble");  // the operator's, not a refusal
+  book.set_candidate_state(2, CandidateState::kRejected,
+                           "rubble");  // the operator's, not a refusal
   ASSERT_EQ(book.refused_points("a").size(), 1u);
   EXPECT_EQ(book.refused_points("a")[0], Eigen::Vector2d(10, 0));
   EXPECT_TRUE(book.refused_points("b").empty()) << "robot b may still go there";
