@@ -69,6 +69,10 @@ void Api::install(http::Router& router) {
                  return decide(r, params.at("id"), action);
                });
   }
+  router.add("GET", "/api/v1/report.html", [this](const Request& r, const auto&) {
+    require(r, Role::kViewer);
+    return report();
+  });
   router.add("GET", "/api/v1/export/{file}", [this](const Request& r, const auto& params) {
     require(r, Role::kViewer);
     return export_file(params.at("file"));

@@ -71,6 +71,8 @@ class Api {
                         const std::string& action);
   // GET /api/v1/export/{map.ply,map.las,poses.csv,annotations.geojson}.
   http::Response export_file(const std::string& name) const;
+  // GET /api/v1/report.html: the mission report.
+  http::Response report() const;
   http::Response list_annotations() const;
   http::Response post_annotation(const http::Request& request);
   http::Response delete_annotation(const http::Request& request, const std::string& id);

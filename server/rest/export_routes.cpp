@@ -4,6 +4,8 @@
 #include <memory>
 
 #include "app/exports.hpp"
+#include "app/mission_report.hpp"
+#include "common/iso_time.hpp"
 #include "http/http_error.hpp"
 #include "rest/api.hpp"
 
@@ -46,6 +48,29 @@ Response Api::export_file(const std::string& name) const {
   // Shared, not copied: a whole map is hundreds of megabytes.
   Response r = Response::shared(std::make_shared<const std::string>(std::move(body)), type);
   r.set_header("Content-Disposition", "attachment; filename=\"scanplan-" + name + "\"");
+  r.set_header("Cache-Control", "no-store");
+  return r;
+}
+
+Response Api::report() const {
+  ReportInput in;
+  in.session_dir = session_dir_;
+  in.generated_at = iso8601_utc_now();
+  in.scans = app_.map.scans();
+  in.waiting = app_.map.waiting();
+  in.areas = app_.map.areas();
+  for (const StoredScan& s : in.scans) {
+    if (const auto a = app_.map.areas_after(s.id)) in.areas_after[s.id] = *a;
+  }
+  in.params = app_.map.params();
+  in.regions = app_.map.layer("regions");
+  in.annotations = app_.annotations.list();
+  try {
+    in.decisions = app_.mission.log(100000);
+  } catch (const SessionStoreError& e) {
+    throw HttpError(503, "storage_failed", std::string("the session cannot be read: ") + e.what());
+  }
+  Response r = Response::bytes(mission_report_html(in), "text/html; charset=utf-8");
   r.set_header("Cache-Control", "no-store");
   return r;
 }

@@ -177,3 +177,26 @@ test('the terminal operator saves an export to a file', async () => {
   const bad = await run(['export', 'map.xyz']);
   assert.notEqual(bad.code, 0);
 });
+
+test('the mission report is one printable page with the map, the marks, the scans and the decisions', async () => {
+  const set = await stack.api('PUT', '/api/v1/params', { body: JSON.stringify({ no_go: [[[20, 10], [25, 10], [25, 15]]], by: 'Ann' }) });
+  assert.equal(set.status, 200);
+  const r = await stack.api('GET', '/api/v1/report.html', { auth: stack.viewerToken });
+  assert.equal(r.status, 200);
+  assert.match(r.headers.get('content-type'), /^text\/html/);
+  const html = await r.text();
+  assert.match(html, /^<!DOCTYPE html>/);
+  // Self-contained: the map is inline, nothing is fetched from anywhere.
+  assert.match(html, /<img alt="top view of the map" src="data:image\/png;base64,[A-Za-z0-9+/]{1000,}={0,2}">/);
+  assert.doesNotMatch(html, /(src|href)="(https?:)?\/\//);
+  assert.doesNotMatch(html, /<script/);
+  // The mark, numbered on the map and in the table, with its coordinates, text, author and time.
+  assert.match(html, /<span class="mark" style="left:[\d.]+%;top:[\d.]+%;background:#d62728" title="victim">1<\/span>/);
+  assert.match(html, /<td>1<\/td><td class="kind-victim">victim<\/td><td>-12\.50, 3\.25, 0\.40<\/td><td>two adults, &quot;responsive&quot;<\/td><td>operator Ann<\/td><td>\d{4}-/);
+  // The scan with its pose and what matching did; the coverage; the decisions.
+  assert.match(html, /<tr><td>1<\/td><td>robot1<\/td><td>\d{4}-[^<]+<\/td><td>-15\.00, -8\.00, [-\d.]+, 0\.0<\/td><td>\d+<\/td><td>the reference \(first scan\)<\/td><\/tr>/);
+  assert.match(html, /<h2>Coverage<\/h2><p>Now: [\d.]+ % of the target region scan-completed/);
+  assert.match(html, /<svg class="chart"[^>]*>[\s\S]*<title>scan 1: [\d.]+ % completed<\/title>/);
+  assert.match(html, /params · by operator Ann/);
+  assert.match(html, /1 no-go zones · 1 marks/);
+});

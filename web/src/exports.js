@@ -1,5 +1,6 @@
 // Exports for other teams (GET /api/v1/export/...): the registered map as PLY or LAS, the scan
-// poses as CSV, the annotations as GeoJSON, all in the map frame. The API wants the token in a
+// poses as CSV, the annotations as GeoJSON, all in the map frame; and the printable mission
+// report (GET /api/v1/report.html). The API wants the token in a
 // header, which a plain link cannot send: the file is fetched, then saved from memory.
 import { apiFetch } from './api.js';
 
@@ -32,7 +33,8 @@ export class ExportMenu {
     this.show(`preparing ${name}…`, false);
     try {
       // A whole map is tens to hundreds of megabytes: give the server and the link time.
-      const res = await apiFetch(`/api/v1/export/${name}`, { timeoutMs: 300000 });
+      const path = name === 'report.html' ? '/api/v1/report.html' : `/api/v1/export/${name}`;
+      const res = await apiFetch(path, { timeoutMs: 300000 });
       const blob = await res.blob();
       const url = URL.createObjectURL(blob);
       const a = document.createElement('a');
