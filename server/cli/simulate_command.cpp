@@ -269,6 +269,12 @@ void run_simulate(const SimulateArgs& a) {
     csv << row << std::flush;
     cv::Mat img = render_regions(*pipeline.regions(), &*pipeline.movable(), pipeline.scan_points());
     draw_plan(img, *pipeline.regions(), s.candidates, s.chosen);
+    char title[200];
+    std::snprintf(title, sizeof title,
+                  "%s, %s policy, seed %llu: scan %d, %.1f %% covered, %.0f m driven",
+                  world.name.c_str(), a.policy.c_str(), static_cast<unsigned long long>(a.seed),
+                  s.scan, s.coverage_pct, s.path_m);
+    img = captioned_regions(img, *pipeline.regions(), title);
     char name[32];
     std::snprintf(name, sizeof name, "step_%02d.png", s.scan);
     cv::imwrite((out / name).string(), img);

@@ -1,6 +1,8 @@
 #include "scanplan/mapping/top_view.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -111,6 +113,93 @@ cv::Point top_view_pixel(const RegionMap& regions, const Eigen::Vector2d& p,
 std::vector<std::uint8_t> encode_png(const cv::Mat& bgr) {
   std::vector<std::uint8_t> out;
   if (!cv::imencode(".png", bgr, out)) throw std::runtime_error("PNG encoding failed");
+  return out;
+}
+
+namespace {
+
+constexpr int kBand = 28;  // px: a line of caption text
+constexpr double kText = 0.45;
+
+void text_at(cv::Mat& img, const std::string& text, cv::Point at) {
+  cv::putText(img, text, at, cv::FONT_HERSHEY_SIMPLEX, kText, cv::Scalar(235, 235, 235), 1,
+              cv::LINE_AA);
+}
+
+int text_width(const std::string& text) {
+  int baseline = 0;
+  return cv::getTextSize(text, cv::FONT_HERSHEY_SIMPLEX, kText, 1, &baseline).width;
+}
+
+}  // namespace
+
+cv::Mat captioned_regions(const cv::Mat& top_view, const RegionMap& regions,
+                          const std::string& title, const TopViewStyle& style) {
+  struct Key {
+    cv::Scalar colour;
+    bool ring;  // a mark drawn as a circle (scan points, candidates) rather than a cell colour
+    std::string label;
+  };
+  const auto cell = [](const cv::Vec3b& c) { return cv::Scalar(c[0], c[1], c[2]); };
+  const std::vector<Key> keys = {
+      {cell(kCompleted), false, "scan-completed (C)"},
+      {cell(kLowMovable), false, "low resolution, movable (M)"},
+      {cell(kLowNotMovable), false, "low resolution, not movable"},
+      {cell(kUnscanned), false, "unscanned (U)"},
+      {cell(kOutside), false, "outside the target region"},
+      {cv::Scalar(220, 60, 20), true, "first scan"},
+      {cv::Scalar(30, 30, 220), true, "latest scan"},
+      {cv::Scalar(255, 255, 255), true, "candidate (rank)"},
+      {cv::Scalar(40, 180, 40), true, "chosen, with its drive"},
+  };
+  // The legend flows over as many rows as the width needs.
+  const int width = std::max(top_view.cols, 480);
+  std::vector<std::vector<const Key*>> rows(1);
+  int x = 8;
+  for (const Key& k : keys) {
+    const int w = 22 + text_width(k.label) + 14;
+    if (x + w > width && !rows.back().empty()) {
+      rows.emplace_back();
+      x = 8;
+    }
+    rows.back().push_back(&k);
+    x += w;
+  }
+  const int legend_h = kBand * static_cast<int>(rows.size() + 1);  // + the scale bar's row
+  cv::Mat out(kBand + top_view.rows + legend_h, width, top_view.type(), cv::Scalar(30, 26, 24));
+  top_view.copyTo(out(cv::Rect(0, kBand, top_view.cols, top_view.rows)));
+  text_at(out, title, {8, kBand - 9});
+
+  int y = kBand + top_view.rows + kBand - 9;
+  for (const auto& row : rows) {
+    x = 8;
+    for (const Key* k : row) {
+      const cv::Point c(x + 7, y - 4);
+      if (k->ring) {
+        cv::circle(out, c, 6, k->colour, -1, cv::LINE_AA);
+        cv::circle(out, c, 6, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+      } else {
+        cv::rectangle(out, {x, y - 11}, {x + 14, y + 3}, k->colour, -1);
+        cv::rectangle(out, {x, y - 11}, {x + 14, y + 3}, cv::Scalar(120, 120, 120), 1);
+      }
+      text_at(out, k->label, {x + 20, y});
+      x += 22 + text_width(k->label) + 14;
+    }
+    y += kBand;
+  }
+  // A bar of a round length near a fifth of the image, and which way is north.
+  const double px_per_m = style.px_per_cell / regions.cells.cell_m;
+  double bar_m = 1;
+  for (const double step : {1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0}) {
+    if (step * px_per_m <= top_view.cols / 5.0) bar_m = step;
+  }
+  const int bar_px = static_cast<int>(std::lround(bar_m * px_per_m));
+  cv::line(out, {8, y - 4}, {8 + bar_px, y - 4}, cv::Scalar(235, 235, 235), 2);
+  cv::line(out, {8, y - 9}, {8, y + 1}, cv::Scalar(235, 235, 235), 2);
+  cv::line(out, {8 + bar_px, y - 9}, {8 + bar_px, y + 1}, cv::Scalar(235, 235, 235), 2);
+  char scale[96];
+  std::snprintf(scale, sizeof scale, "%.0f m    north up, map frame", bar_m);
+  text_at(out, scale, {16 + bar_px, y});
   return out;
 }
 

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include "mapping_test_support.hpp"
 #include "scanplan/mapping/movable_region.hpp"
 #include "scanplan/mapping/region_segmentation.hpp"
@@ -27,6 +29,26 @@ TEST(TopView, LayersHaveTheTargetsShapeAndColours) {
   ASSERT_GT(png.size(), 8u);
   EXPECT_EQ(png[1], 'P');
   EXPECT_EQ(encode_png(render_movable(map, m, r, style))[2], 'N');
+}
+
+TEST(TopView, ACaptionedViewKeepsTheMapAndAddsTitleLegendAndScale) {
+  MlsMap map;
+  map.insert(slab(0, 30, 0, 10, 0.0f));
+  const RegionMap r =
+      segment_regions(map, TargetRegion::rectangle({0, 0}, {200, 40}), {{0.5, 0.5}});
+  const cv::Mat view = render_regions(r, nullptr, {{0.5, 0.5}});
+  const cv::Mat out = captioned_regions(view, r, "campus, scan 3");
+  ASSERT_GE(out.cols, view.cols);
+  EXPECT_GT(out.rows, view.rows + 3 * 28) << "a title band, a legend and a scale bar";
+  // The map itself is there untouched, below the title band.
+  cv::Mat diff;
+  cv::absdiff(out(cv::Rect(0, 28, view.cols, view.rows)), view, diff);
+  EXPECT_EQ(cv::countNonZero(diff.reshape(1)), 0);
+  // The bands are written on (text and swatches), not left blank.
+  const cv::Mat title = out(cv::Rect(0, 0, out.cols, 28));
+  cv::Mat grey;
+  cv::cvtColor(title, grey, cv::COLOR_BGR2GRAY);
+  EXPECT_GT(cv::countNonZero(grey > 200), 50);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <opencv2/core.hpp>
+#include <string>
 #include <vector>
 
 #include "scanplan/mapping/movable_region.hpp"
@@ -33,6 +34,12 @@ cv::Mat render_movable(const MlsMap& map, const MovableRegion& movable, const Re
                        const TopViewStyle& style = {});
 
 std::vector<std::uint8_t> encode_png(const cv::Mat& bgr);
+
+// A regions top view (render_regions, perhaps with a plan drawn over it) that explains itself
+// outside the page (scanplan simulate's step images): `title` in a band above it and, below,
+// the legend of its colours and marks and a scale bar.
+cv::Mat captioned_regions(const cv::Mat& top_view, const RegionMap& regions,
+                          const std::string& title, const TopViewStyle& style = {});
 
 // The pixel of a map position in a top view of `regions`.
 cv::Point top_view_pixel(const RegionMap& regions, const Eigen::Vector2d& p,
