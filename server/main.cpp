@@ -145,7 +145,6 @@ void serve(http::ServerConfig config, int count, const http::Router& router,
   stop_loops();
 }
 
-// The whole server: storage, the application, DDS and HTTP, wired and run until stopped.
 // The parameters the operator last set in this session (the target region, the no-go zones, α,
 // ...), so that a restarted server plans as before. Stored ones it cannot take (from a version
 // that checked less) are reported and left out: the defaults are a working mission.
@@ -163,6 +162,7 @@ void resume_params(const scanplan::SessionStore& session, srv::LiveMap& map) {
   }
 }
 
+// The whole server: storage, the application, DDS and HTTP, wired and run until stopped.
 void run(const Options& o) {
   // A file-size limit (RLIMIT_FSIZE) is a full disk by another name: a write beyond it must fail
   // with EFBIG, which the session store reports, not kill the server with SIGXFSZ.

@@ -73,10 +73,22 @@ test('each robot shows its own drive and its own scan progress', { timeout: 1200
     const { page, problems } = await openPage(context, `${stack.url}/?token=${encodeURIComponent(stack.token)}`);
     await waitForData(page, 'both plans', () =>
       ['robot1', 'robot2'].every((r) => document.querySelector(`#cand-list .cand-row[data-robot="${r}"]`)));
-    // robot2 drives to its best point; the metres to go shrink while it does (its bridge reports
-    // where it is on the way).
-    const free = page.locator('#cand-list .cand-row[data-robot="robot2"][data-state="proposed"]').first();
-    await free.click();
+    // robot2 drives to its farthest point (the longest drive: several reports even on a busy
+    // machine); the metres to go shrink while it does (its bridge reports where it is).
+    // After the first test robot1 drove and scans (scan 3): wait for the plans made after that,
+    // or the point picked here is superseded before it is approved.
+    const plan = await stack.waitFor('the plans after robot1\'s scan', async () => {
+      const s = await (await stack.api('GET', '/api/v1/session')).json();
+      const c = await (await stack.api('GET', '/api/v1/candidates')).json();
+      const busy = ['robot1', 'robot2'].some((r) => s.robots[r]?.state === 'moving' || s.robots[r]?.scan?.state === 'scanning');
+      return s.scans >= 3 && !busy && c.plans.length === 2 && c.plans.every((p) => p.based_on_scan === s.scans) ? c : undefined;
+    });
+    await page.waitForFunction((id) => document.querySelector(`#cand-list .cand-row[data-id="${id}"]`),
+      plan.candidates.find((c) => c.robot === 'robot2')?.id);
+    const far = plan.candidates.filter((c) => c.robot === 'robot2' && c.state === 'proposed')
+      .sort((a, b) => b.travel_m - a.travel_m)[0];
+    assert.ok(far && far.travel_m > 15, `a drive long enough to watch: ${far?.travel_m} m`);
+    await page.locator(`#cand-list .cand-row[data-id="${far.id}"]`).click();
     await page.click('#approve');
     await page.waitForSelector('#confirm[open]');
     await page.click('#confirm-ok');
@@ -90,7 +102,8 @@ test('each robot shows its own drive and its own scan progress', { timeout: 1200
       if (/arrived|scanning|idle/.test(line) && seen.length) break;
       await page.waitForTimeout(100);
     }
-    assert.ok(seen.length >= 2, `distances to go seen: ${seen}`);
+    const lines = await page.evaluate(() => [...document.querySelectorAll('#robots .robot-line')].map((l) => l.innerText));
+    assert.ok(seen.length >= 2, `distances to go seen: ${seen}; robots: ${JSON.stringify(lines)}`);
     assert.ok(seen[seen.length - 1] < seen[0], `the distance to go shrinks: ${seen}`);
 
     // Both robots scan at once: each line has its own progress.
