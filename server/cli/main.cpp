@@ -8,6 +8,7 @@
 #include "candidates_command.hpp"
 #include "decision_command.hpp"
 #include "export_command.hpp"
+#include "operator_actions.hpp"
 #include "register_command.hpp"
 #include "replay_command.hpp"
 #include "scan_command.hpp"
@@ -27,6 +28,7 @@ int main(int argc, char** argv) {
   scanplan::cli::add_candidates_command(app);
   scanplan::cli::add_area_command(app);
   scanplan::cli::add_export_command(app);
+  scanplan::cli::add_operator_actions(app);
   scanplan::cli::add_decision_commands(app);
   scanplan::cli::add_watch_command(app);
   try {

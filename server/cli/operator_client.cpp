@@ -67,6 +67,11 @@ std::string OperatorClient::post(const std::string& path, const nlohmann::json& 
   return send("POST", path, body.is_null() ? std::string() : body.dump(), action).body;
 }
 
+std::string OperatorClient::del(const std::string& path, const nlohmann::json& body,
+                                const std::string& action) const {
+  return send("DELETE", path, body.is_null() ? std::string() : body.dump(), action).body;
+}
+
 std::string OperatorClient::put(const std::string& path, const nlohmann::json& body,
                                 const std::string& action) const {
   return send("PUT", path, body.dump(), action).body;

@@ -27,6 +27,8 @@ class OperatorClient {
                    const std::string& action) const;
   std::string put(const std::string& path, const nlohmann::json& body,
                   const std::string& action) const;
+  std::string del(const std::string& path, const nlohmann::json& body,
+                  const std::string& action) const;
 
   const std::string& server() const { return http_.base(); }
   const std::string& token() const { return token_; }

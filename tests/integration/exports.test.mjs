@@ -200,3 +200,43 @@ test('the mission report is one printable page with the map, the marks, the scan
   assert.match(html, /params · by operator Ann/);
   assert.match(html, /1 no-go zones · 1 marks/);
 });
+
+test('the terminal operator proposes a point, marks the map and takes a scan out and back', async () => {
+  const run = (args, token = stack.token) => new Promise((resolve) => {
+    const child = spawn(requireEnv('SCANPLAN_CLI'), [...args, '--server', stack.url, '--token', token],
+      { stdio: ['ignore', 'pipe', 'pipe'] });
+    let stdout = '', stderr = '';
+    child.stdout.on('data', (d) => { stdout += d; });
+    child.stderr.on('data', (d) => { stderr += d; });
+    child.on('exit', (code) => resolve({ code, stdout, stderr }));
+  });
+  const mark = await run(['annotate', 'hazard', '5', '-10', '--text', 'leaning wall', '--by', 'Bo']);
+  assert.equal(mark.code, 0, mark.stderr);
+  assert.match(mark.stdout, /^hazard #\d+ at \(5\.0, -10\.0\), z 0\.0 m by operator Bo: leaning wall$/m);
+  const bad = await run(['annotate', 'note', '1', '1']);
+  assert.equal(bad.code, 9, 'a note needs its text: the server says so');
+  assert.match(bad.stderr, /text/);
+
+  const goal = await run(['propose', '-4.2', '-4.7', '--by', 'Bo']);
+  assert.equal(goal.code, 0, goal.stderr);
+  assert.match(goal.stdout, /proposed for robot1; send it there with: scanplan approve \d+/);
+  const inside = await run(['propose', '14', '6']);
+  assert.equal(inside.code, 9);
+  assert.match(inside.stderr, /not been scanned/);
+
+  const only = await run(['exclude-scan', '1']);
+  assert.equal(only.code, 6, 'the only scan stays: the server refuses (409)');
+  assert.match(only.stderr, /scan 1 is the only one in the map/);
+  await scanAndWait(stack, 2);
+  await stack.waitFor('scan 2 in the map', async () => {
+    const s = await (await stack.api('GET', '/api/v1/scans/2')).json();
+    return s.in_map !== false && s.id === 2 ? s : undefined;
+  });
+  const out = await run(['exclude-scan', '2', '--reason', 'drifted', '--by', 'Bo']);
+  assert.equal(out.code, 0, out.stderr);
+  assert.match(out.stdout, /scan 2 is out of the map/);
+  const back = await run(['exclude-scan', '2', '--restore']);
+  assert.equal(back.code, 0, back.stderr);
+  assert.match(back.stdout, /scan 2 is back in the map/);
+  assert.equal((await run(['exclude-scan', '2'], stack.viewerToken)).code, 4);
+});
