@@ -6,6 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "operator_client.hpp"
+#include "operator_options.hpp"
 #include "scanplan/io/ply_io.hpp"
 #include "scanplan/mapping/colorizer.hpp"
 #include "scanplan/sim/simulated_shot.hpp"
@@ -65,22 +67,53 @@ void run_scan(const ScanArgs& a) {
   std::cout << out.dump() << std::endl;
 }
 
+// The terminal operator's "scan here" (POST /api/v1/scan): every robot, or one.
+void request_scan(const OperatorOptions& o, const std::string& robot) {
+  const OperatorClient client(o);
+  const std::string answer =
+      client.post("/api/v1/scan" + (robot.empty() ? std::string() : "?robot=" + robot),
+                  nlohmann::json(), "ask for a scan");
+  const nlohmann::json j = nlohmann::json::parse(answer, nullptr, false);
+  if (o.json) {
+    std::cout << j.dump() << std::endl;
+    return;
+  }
+  const std::string who = j.is_object() ? j.value("robot", std::string("*")) : "*";
+  std::cout << "scan requested from " << (who == "*" ? std::string("every robot") : who)
+            << " (command " << (j.is_object() ? j.value("command_id", 0u) : 0u)
+            << "); follow it with scanplan watch" << std::endl;
+}
+
 }  // namespace
 
 void add_scan_command(CLI::App& app) {
   auto args = std::make_shared<ScanArgs>();
-  CLI::App* cmd = app.add_subcommand("scan", "one simulated scan of a world, written as PLY");
-  cmd->add_option("--world", args->world, "world file (JSON)")
-      ->required()
+  auto op = std::make_shared<OperatorOptions>();
+  auto robot = std::make_shared<std::string>();
+  CLI::App* cmd = app.add_subcommand(
+      "scan",
+      "with --world: one simulated scan of a world, written as PLY; without: the terminal "
+      "operator asks the robots of a running server to scan where they stand");
+  cmd->add_option("--world", args->world, "world file (JSON): simulate a scan offline")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--at", args->at, "where the robot stands: x,y,z,yaw_deg")
-      ->required()
+  cmd->add_option("--at", args->at, "with --world: where the robot stands, x,y,z,yaw_deg")
       ->delimiter(',')
       ->expected(4);
-  cmd->add_option("--out", args->out, "output PLY (points in the robot frame)")->required();
-  cmd->add_option("--seed", args->seed, "noise seed")->capture_default_str();
-  cmd->add_option("--image", args->image, "also write the camera's panorama (JPEG or PNG)");
-  cmd->callback([args] { run_scan(*args); });
+  cmd->add_option("--out", args->out, "with --world: output PLY (points in the robot frame)");
+  cmd->add_option("--seed", args->seed, "with --world: noise seed")->capture_default_str();
+  cmd->add_option("--image", args->image,
+                  "with --world: also write the camera's panorama (JPEG or PNG)");
+  cmd->add_option("--robot", *robot, "without --world: only this robot scans (default: every one)");
+  add_operator_options(cmd, *op, "without --world: print the server's answer");
+  cmd->callback([args, op, robot] {
+    if (args->world.empty()) {
+      run_operator_command("scan", [&] { request_scan(*op, *robot); });
+      return;
+    }
+    if (args->at.size() != 4) throw CLI::RequiredError("--at (with --world)");
+    if (args->out.empty()) throw CLI::RequiredError("--out (with --world)");
+    run_scan(*args);
+  });
 }
 
 }  // namespace scanplan::cli

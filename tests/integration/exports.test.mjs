@@ -227,7 +227,15 @@ test('the terminal operator proposes a point, marks the map and takes a scan out
   const only = await run(['exclude-scan', '1']);
   assert.equal(only.code, 6, 'the only scan stays: the server refuses (409)');
   assert.match(only.stderr, /scan 1 is the only one in the map/);
-  await scanAndWait(stack, 2);
+  const scan = await run(['scan', '--robot', 'robot1']);
+  assert.equal(scan.code, 0, scan.stderr);
+  assert.match(scan.stdout, /^scan requested from robot1 \(command \d+\); follow it with scanplan watch$/m);
+  const offline = await run(['scan', '--world', join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples/worlds/yard.json')]);
+  assert.notEqual(offline.code, 0, 'a simulated scan still needs --at and --out');
+  assert.match(offline.stderr, /--at/);
+
+  await stack.waitFor('scan 2 in the session', async () =>
+    ((await (await stack.api('GET', '/api/v1/session')).json()).scans >= 2) || undefined);
   await stack.waitFor('scan 2 in the map', async () => {
     const s = await (await stack.api('GET', '/api/v1/scans/2')).json();
     return s.in_map !== false && s.id === 2 ? s : undefined;
