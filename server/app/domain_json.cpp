@@ -17,6 +17,19 @@ json areas_json(const MapAreas& a) {
           {"movable_m2", a.movable_m2}};
 }
 
+json progress_json(const MissionProgress& p) {
+  json j = {{"state", p.state},
+            {"coverage_pct", p.coverage_pct},
+            {"best_gain_m2", p.best_gain_m2},
+            {"threshold_m2", p.threshold_m2},
+            {"scans_left", p.scans_left ? json(*p.scans_left) : json(nullptr)}};
+  if (p.state == "finished") {
+    j["finished_by"] = p.finished_by;
+    j["finished_at"] = p.finished_at;
+  }
+  return j;
+}
+
 json layer_geometry_json(const LayerGeometry& g) {
   return {{"min", {g.min_x, g.min_y}},
           {"max", {g.max_x, g.max_y}},

@@ -7,6 +7,7 @@
 
 #include "app/live_map.hpp"
 #include "app/mission.hpp"
+#include "app/mission_progress.hpp"
 #include "app/plan_book.hpp"
 #include "app/robot_board.hpp"
 #include "app/scan_intake.hpp"
@@ -21,6 +22,7 @@ namespace scanplan::server {
 
 nlohmann::json pose_json(const Pose& p);  // {x, y, z, yaw_deg}
 nlohmann::json areas_json(const MapAreas& a);
+nlohmann::json progress_json(const MissionProgress& p);
 nlohmann::json layer_geometry_json(const LayerGeometry& g);
 // Scans the session holds that are not in the map, and why: [{id, robot, reason}].
 nlohmann::json not_in_map_json(const std::vector<ScanIntake::NotInMap>& scans);

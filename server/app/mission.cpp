@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "app/domain_json.hpp"
+#include "common/iso_time.hpp"
 
 namespace scanplan::server {
 
@@ -13,7 +14,38 @@ using nlohmann::json;
 
 Mission::Mission(LiveMap& map, PlanBook& plans, const RobotBoard& robots, RobotLink& link,
                  SessionStore& session, const Events& events)
-    : map_(map), plans_(plans), robots_(robots), link_(link), session_(session), events_(events) {}
+    : map_(map), plans_(plans), robots_(robots), link_(link), session_(session), events_(events) {
+  // Whether the operator finished the mission before a restart: the last finish or resume.
+  try {
+    for (const SessionEvent& e : session_.events(1000000)) {
+      if (e.kind == "resume") finished_.reset();
+      if (e.kind != "finish") continue;
+      const json d = json::parse(e.json, nullptr, false);
+      finished_ = {d.is_object() ? d.value("by", std::string("operator")) : "operator", e.at};
+    }
+  } catch (const std::exception& e) {
+    spdlog::error("could not read whether the mission was finished: {}", e.what());
+  }
+}
+
+void Mission::finish(const std::string& by, const std::string& reason) {
+  std::lock_guard lock(mutex_);
+  json details = {{"by", by}};
+  if (!reason.empty()) details["reason"] = reason;
+  record("finish", details);
+  finished_ = {by, iso8601_utc_now(TimePrecision::kMilliseconds)};
+}
+
+void Mission::resume(const std::string& by) {
+  std::lock_guard lock(mutex_);
+  record("resume", {{"by", by}});
+  finished_.reset();
+}
+
+std::optional<std::pair<std::string, std::string>> Mission::finished() const {
+  std::lock_guard lock(mutex_);
+  return finished_;
+}
 
 void Mission::record(const std::string& kind, json details) {
   details["kind"] = kind;

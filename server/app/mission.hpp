@@ -83,6 +83,12 @@ class Mission {
   // The operator's parameters (PUT /api/v1/params): applied (the plans are made anew), kept in
   // the session for a restart, recorded as "params" and announced to every page.
   MissionParams set_params(const MissionParams& params, const std::string& by);
+  // The operator ends the mission (nothing more is worth scanning, or the crew must leave), or
+  // takes it up again: recorded as "finish" / "resume"; a restarted server knows (the log).
+  void finish(const std::string& by, const std::string& reason);
+  void resume(const std::string& by);
+  // Who finished it and when, while it stands.
+  std::optional<std::pair<std::string, std::string>> finished() const;
 
   // From the robots' side (the DDS thread).
   void on_status(const std::string& robot, const RobotStatus& status);
@@ -92,6 +98,7 @@ class Mission {
   void on_robot_back(const std::string& robot);
 
  private:
+  std::optional<std::pair<std::string, std::string>> finished_;  // by, at
   struct ActiveMove {
     std::uint32_t command_id;
     std::uint64_t candidate;
@@ -112,7 +119,7 @@ class Mission {
   RobotLink& link_;
   SessionStore& session_;
   const Events& events_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::map<std::string, ActiveMove> moving_;  // by robot
 };
 

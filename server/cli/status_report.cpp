@@ -55,6 +55,23 @@ std::vector<std::string> render_status(const std::string& server, const json& se
                        fixed(a.at("low_resolution_m2").get<double>(), 0) + " m2, unscanned " +
                        fixed(a.at("unscanned_m2").get<double>(), 0) + " m2, movable " +
                        fixed(a.at("movable_m2").get<double>(), 0) + " m2"));
+  if (const auto m = session.find("mission"); m != session.end() && m->is_object()) {
+    const std::string state = m->value("state", "");
+    std::string text = fixed(m->value("coverage_pct", 0.0), 0) + " % of the area scanned";
+    if (state == "finished") {
+      text = "finished by " + m->value("finished_by", std::string("?")) + " at " +
+             m->value("finished_at", std::string("?")) + "; " + text;
+    } else if (state == "complete") {
+      text = "complete: no suggested point adds more than " +
+             fixed(m->value("threshold_m2", 0.0), 0) + " m2; " + text;
+    } else {
+      text += ", the next scan adds about " + fixed(m->value("best_gain_m2", 0.0), 0) + " m2";
+      if (const auto left = m->find("scans_left"); left != m->end() && left->is_number()) {
+        text += ", about " + std::to_string(left->get<int>()) + " more scans";
+      }
+    }
+    out.push_back(row("mission", text));
+  }
 
   const json& robots = session.at("robots");
   if (robots.empty()) out.push_back(row("robots", "none has reported yet"));

@@ -69,6 +69,12 @@ void Api::install(http::Router& router) {
                  return decide(r, params.at("id"), action);
                });
   }
+  for (const std::string action : {"finish", "resume"}) {
+    router.add("POST", "/api/v1/mission/" + action, [this, action](const Request& r, const auto&) {
+      require(r, Role::kOperator);
+      return end_mission(r, action == "finish");
+    });
+  }
   router.add("GET", "/api/v1/report.html", [this](const Request& r, const auto&) {
     require(r, Role::kViewer);
     return report();
@@ -152,6 +158,7 @@ Response Api::session(const Request& request) const {
             {"robots", robots},
             {"role", auth_.role_of(request) == Role::kOperator ? "operator" : "viewer"}};
   j["areas"] = areas_json(app_.map.areas());
+  j["mission"] = progress_json(progress());
   if (const auto g = app_.map.layer_geometry()) j["layers"] = layer_geometry_json(*g);
   // A reopened session is not an empty one: its scans are coming back.
   if (const auto r = app_.intake.rebuilding()) {

@@ -7,6 +7,7 @@
 #include "app/annotations.hpp"
 #include "app/live_map.hpp"
 #include "app/mission.hpp"
+#include "app/mission_progress.hpp"
 #include "app/plan_book.hpp"
 #include "app/robot_board.hpp"
 #include "app/scan_intake.hpp"
@@ -71,6 +72,10 @@ class Api {
                         const std::string& action);
   // GET /api/v1/export/{map.ply,map.las,poses.csv,annotations.geojson}.
   http::Response export_file(const std::string& name) const;
+  // POST /api/v1/mission/finish and /resume: the operator ends the mission, or takes it up.
+  http::Response end_mission(const http::Request& request, bool finish);
+  // How far the mission has come (GET /api/v1/session's "mission").
+  MissionProgress progress() const;
   // GET /api/v1/report.html: the mission report.
   http::Response report() const;
   http::Response list_annotations() const;

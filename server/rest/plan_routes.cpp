@@ -235,4 +235,31 @@ Response Api::put_params(const Request& request) {
   return Response::json(200, params_json(app_.mission.set_params(p, by)));
 }
 
+Response Api::end_mission(const Request& request, bool finish) {
+  json body = json::object();
+  if (!request.body.empty()) {
+    body = rest::object_body(request,
+                             "the body, when given, is {\"by\": \"name\", \"reason\": \"...\"}");
+  }
+  for (const auto& [key, value] : body.items()) {
+    if (key != "by" && key != "reason")
+      throw HttpError(400, "bad_request", "unknown field '" + key + "'");
+  }
+  const std::string by = rest::decided_by(body);
+  if (finish) {
+    app_.mission.finish(by, rest::text_in(body, "reason", rest::kMaxReasonBytes, TextKind::kProse));
+  } else {
+    app_.mission.resume(by);
+  }
+  return Response::json(200, progress_json(progress()));
+}
+
+MissionProgress Api::progress() const {
+  std::vector<MapAreas> after;
+  for (const StoredScan& s : app_.map.scans()) {
+    if (const auto a = app_.map.areas_after(s.id)) after.push_back(*a);
+  }
+  return mission_progress(app_.map.areas(), after, app_.plans.plans(), app_.mission.finished());
+}
+
 }  // namespace scanplan::server

@@ -49,6 +49,17 @@ test('every suggestion refused: the page says so and offers the operator\'s own 
     const text = await page.locator('.all-refused').innerText();
     assert.match(text, /robot1 refused every suggested point\. Click a spot on the top view to propose your own/);
     t.diagnostic(`shot: ${await screenshot(page, 'all-refused.png')}`);
+
+    // The mission's progress line, and the operator finishing the mission from the page.
+    assert.match(await page.locator('#mission-progress').innerText(), /\d+ % of the area scanned/);
+    await page.click('#finish-mission');
+    await page.waitForSelector('#confirm[open]');
+    await page.fill('#confirm-reason', 'recording replayed');
+    await page.click('#confirm-ok');
+    await page.waitForFunction(() => document.getElementById('mission-progress').dataset.state === 'finished');
+    assert.match(await page.locator('#mission-progress').innerText(), /^mission finished by operator/);
+    assert.equal(await page.locator('#finish-mission').innerText(), 'Resume mission');
+    await page.waitForFunction(() => /finished the mission: recording replayed/.test(document.getElementById('log').innerText));
     assert.deepEqual(problems.pageErrors, []);
   });
 });

@@ -82,10 +82,24 @@ test('no candidate, goal or drive in a no-go zone, and a restart keeps the area'
   const entry = (log.decisions ?? log).find((d) => d.kind === 'params');
   assert.ok(entry, JSON.stringify(log).slice(0, 400));
 
+  // The mission's progress; the operator finishes it (a viewer may not).
+  const running = (await json(await stack.api('GET', '/api/v1/session'))).body.mission;
+  assert.equal(running.state, 'running', JSON.stringify(running));
+  assert.ok(running.coverage_pct > 0 && running.best_gain_m2 > running.threshold_m2, JSON.stringify(running));
+  assert.equal((await stack.api('POST', '/api/v1/mission/finish', { auth: stack.viewerToken })).status, 403);
+  const fin = await json(await stack.api('POST', '/api/v1/mission/finish', { body: JSON.stringify({ by: 'Ann', reason: 'crew leaves' }) }));
+  assert.equal(fin.status, 200, JSON.stringify(fin.body));
+  assert.equal(fin.body.state, 'finished');
+  assert.equal(fin.body.finished_by, 'operator Ann');
+
   const tokens = { operator: stack.token, viewer: stack.viewerToken };
   const dir = stack.dir;
   await stack.stop({ keepDir: true, signal: 'SIGKILL' });
   stack = await startStack({ bridge: false, dir, tokens });
+  const after = (await json(await stack.api('GET', '/api/v1/session'))).body.mission;
+  assert.equal(after.state, 'finished', 'a restart keeps the operator\'s finish');
+  const again = await json(await stack.api('POST', '/api/v1/mission/resume'));
+  assert.equal(again.body.state, 'running');
   const resumed = (await json(await stack.api('GET', '/api/v1/params'))).body;
   assert.deepEqual(resumed.target, target);
   assert.deepEqual(resumed.no_go, [zone]);

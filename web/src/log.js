@@ -72,6 +72,10 @@ function describe(e) {
       return `proposed custom point ${who} at (${f1(e.x)}, ${f1(e.y)}), F ${Math.round(e.f ?? 0)}`;
     case 'params':
       return paramsChanged(e);
+    case 'finish':
+      return `${e.by ?? 'operator'} finished the mission${e.reason ? `: ${e.reason}` : ''}`;
+    case 'resume':
+      return `${e.by ?? 'operator'} resumed the mission`;
     default:
       return e.kind;
   }

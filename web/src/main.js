@@ -108,6 +108,8 @@ const goals = new GoalPicker(
 const mission = new MissionPanel(
   {
     robots: $('robots'),
+    progressLine: $('mission-progress'),
+    finish: $('finish-mission'),
     progress: $('scan-progress'),
     bar: $('scan-progress-bar'),
     progressText: $('scan-progress-text'),

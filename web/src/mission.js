@@ -34,6 +34,8 @@ export class MissionPanel {
     this.operator = false;
     this.bridges = 0;
     els.scanHere.addEventListener('click', () => this.scanHere());
+    this.progress = null; // GET /api/v1/session's "mission"
+    els.finish?.addEventListener('click', () => this.finishOrResume());
   }
 
   setRole(operator) {
@@ -44,6 +46,7 @@ export class MissionPanel {
   /** From GET /api/v1/session. */
   setSession(s) {
     this.bridges = s.bridges ?? 0;
+    this.progress = s.mission || null;
     for (const [id, r] of Object.entries(s.robots || {})) {
       this.robots[id] = {
         ...(this.robots[id] || {}),
@@ -244,10 +247,64 @@ export class MissionPanel {
       match.classList.remove('warn');
     }
     match.title = this.matchHistory().join('\n');
+    this.renderProgress();
     scanHere.hidden = !this.operator;
     // "Scan here" asks every robot: not while any of them is scanning.
     scanHere.disabled = !this.bridges || Object.values(this.scans).some((x) => x.state === 'scanning');
     message.hidden = !message.textContent;
+  }
+
+  /** Coverage of the area, what the next scan adds, scans left; complete or finished. */
+  renderProgress() {
+    const { progressLine, finish } = this.els;
+    if (!progressLine) return;
+    const p = this.progress;
+    progressLine.dataset.state = p?.state || '';
+    if (!p) {
+      progressLine.textContent = '';
+    } else if (p.state === 'finished') {
+      const at = new Date(p.finished_at);
+      const when = Number.isNaN(at.getTime()) ? '' : ` at ${at.toLocaleTimeString('en-GB', { hour12: false })}`;
+      progressLine.textContent = `mission finished by ${p.finished_by}${when} · ${p.coverage_pct.toFixed(0)} % of the area scanned`;
+    } else if (p.state === 'complete') {
+      progressLine.textContent = `mission complete: ${p.coverage_pct.toFixed(0)} % of the area scanned; no suggested point adds more than ${nf0.format(p.threshold_m2)} m² (best ${nf0.format(p.best_gain_m2)} m²) — finish it, or enlarge the area`;
+    } else {
+      const left = p.scans_left != null ? ` · ≈ ${p.scans_left} more scan${p.scans_left === 1 ? '' : 's'}` : '';
+      const next = p.best_gain_m2 > 0 ? ` · next scan adds ≈ ${nf0.format(p.best_gain_m2)} m²` : '';
+      progressLine.textContent = `${p.coverage_pct.toFixed(0)} % of the area scanned${next}${left}`;
+    }
+    if (finish) {
+      finish.hidden = !this.operator || !p;
+      finish.textContent = p?.state === 'finished' ? 'Resume mission' : 'Finish mission…';
+    }
+  }
+
+  async finishOrResume() {
+    const resume = this.progress?.state === 'finished';
+    let answer = null;
+    if (!resume) {
+      answer = await confirmAction({
+        title: 'Finish the mission?',
+        body: 'Recorded with who and when; the robots stay where they are and the map stays. It can be resumed.',
+        confirm: 'Finish mission',
+        reason: true,
+      });
+      if (!answer) return;
+    }
+    const { message } = this.els;
+    try {
+      const body = {};
+      if (answer?.by) body.by = answer.by;
+      if (answer?.reason) body.reason = answer.reason;
+      this.progress = await sendJson(`/api/v1/mission/${resume ? 'resume' : 'finish'}`, Object.keys(body).length ? body : undefined);
+      message.textContent = resume ? 'mission resumed' : 'mission finished';
+      message.classList.remove('error');
+    } catch (e) {
+      message.textContent = `${resume ? 'resume' : 'finish'} failed: ${e.detail || e.message}`;
+      message.classList.add('error');
+    }
+    this.render();
+    this.onChanged();
   }
 
   async scanHere() {
