@@ -236,15 +236,7 @@ Response Api::put_params(const Request& request) {
 }
 
 Response Api::end_mission(const Request& request, bool finish) {
-  json body = json::object();
-  if (!request.body.empty()) {
-    body = rest::object_body(request,
-                             "the body, when given, is {\"by\": \"name\", \"reason\": \"...\"}");
-  }
-  for (const auto& [key, value] : body.items()) {
-    if (key != "by" && key != "reason")
-      throw HttpError(400, "bad_request", "unknown field '" + key + "'");
-  }
+  const json body = rest::by_and_reason(request);
   const std::string by = rest::decided_by(body);
   if (finish) {
     app_.mission.finish(by, rest::text_in(body, "reason", rest::kMaxReasonBytes, TextKind::kProse));

@@ -82,6 +82,18 @@ std::uint64_t path_id(const std::string& text, const char* what) {
   return n;
 }
 
+json by_and_reason(const Request& request) {
+  if (request.body.empty()) return json::object();
+  json body =
+      object_body(request, "the body, when given, is {\"by\": \"name\", \"reason\": \"...\"}");
+  for (const auto& [key, value] : body.items()) {
+    if (key != "by" && key != "reason") {
+      throw HttpError(400, "bad_request", "unknown field '" + key + "'");
+    }
+  }
+  return body;
+}
+
 json object_body(const Request& request, const char* shape) {
   json body;
   try {

@@ -19,6 +19,9 @@ double query_number(const http::Request& r, const std::string& name);
 std::uint64_t path_id(const std::string& text, const char* what);
 // The request body as a JSON object; `shape` tells the client what is expected.
 nlohmann::json object_body(const http::Request& request, const char* shape);
+// The optional body of a recorded action, {"by": NAME, "reason": TEXT} (either may be left
+// out; nothing else): an empty object when there is no body.
+nlohmann::json by_and_reason(const http::Request& request);
 // body[key] as a number within lo..hi.
 double number_in(const nlohmann::json& body, const char* key, double lo, double hi);
 // body[key] as a coordinate in metres in the map frame, within ±kMaxCoordinateM.

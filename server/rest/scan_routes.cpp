@@ -125,15 +125,7 @@ Response Api::list_scans() const {
 
 Response Api::set_scan_excluded(const Request& request, const std::string& id, bool excluded) {
   const auto n = static_cast<std::int64_t>(rest::path_id(id, "a scan id"));
-  json body = json::object();
-  if (!request.body.empty()) {
-    body = rest::object_body(request,
-                             "the body, when given, is {\"by\": \"name\", \"reason\": \"...\"}");
-  }
-  for (const auto& [key, value] : body.items()) {
-    if (key != "by" && key != "reason")
-      throw HttpError(400, "bad_request", "unknown field '" + key + "'");
-  }
+  const json body = rest::by_and_reason(request);
   const std::string by = rest::decided_by(body);
   const std::string reason = rest::text_in(body, "reason", rest::kMaxReasonBytes, TextKind::kProse);
   try {

@@ -3,11 +3,10 @@
 // from the formats' specifications (not the server's code).
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
 import { mkdtempSync, readFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { requireEnv, scanAndWait, startStack, worldVariant } from '../support/stack.mjs';
+import { requireEnv, runCli, scanAndWait, startStack, worldVariant } from '../support/stack.mjs';
 
 let stack;
 before(async () => {
@@ -163,13 +162,7 @@ test('the map, the poses and the annotations read back as their formats say', as
 
 test('the terminal operator saves an export to a file', async () => {
   const out = join(mkdtempSync(join(tmpdir(), 'scanplan-export-cli-')), 'poses.csv');
-  const run = (args) => new Promise((resolve) => {
-    const child = spawn(requireEnv('SCANPLAN_CLI'), [...args, '--server', stack.url, '--token', stack.viewerToken],
-      { stdio: ['ignore', 'pipe', 'pipe'] });
-    let stderr = '';
-    child.stderr.on('data', (d) => { stderr += d; });
-    child.on('exit', (code) => resolve({ code, stderr }));
-  });
+  const run = (args) => runCli(stack, args, stack.viewerToken);
   const r = await run(['export', 'poses.csv', '--out', out]);
   assert.equal(r.code, 0, r.stderr);
   assert.match(r.stderr, /wrote .*poses\.csv \(\d+ bytes\)/);
@@ -202,14 +195,7 @@ test('the mission report is one printable page with the map, the marks, the scan
 });
 
 test('the terminal operator proposes a point, marks the map and takes a scan out and back', async () => {
-  const run = (args, token = stack.token) => new Promise((resolve) => {
-    const child = spawn(requireEnv('SCANPLAN_CLI'), [...args, '--server', stack.url, '--token', token],
-      { stdio: ['ignore', 'pipe', 'pipe'] });
-    let stdout = '', stderr = '';
-    child.stdout.on('data', (d) => { stdout += d; });
-    child.stderr.on('data', (d) => { stderr += d; });
-    child.on('exit', (code) => resolve({ code, stdout, stderr }));
-  });
+  const run = (args, token) => runCli(stack, args, token);
   const mark = await run(['annotate', 'hazard', '5', '-10', '--text', 'leaning wall', '--by', 'Bo']);
   assert.equal(mark.code, 0, mark.stderr);
   assert.match(mark.stdout, /^hazard #\d+ at \(5\.0, -10\.0\), z 0\.0 m by operator Bo: leaning wall$/m);

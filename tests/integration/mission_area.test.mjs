@@ -3,23 +3,13 @@
 // server restarted on the session plans with them as before.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
 import { mkdtempSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { requireEnv, scanAndWait, startStack, worldVariant } from '../support/stack.mjs';
+import { runCli, scanAndWait, startStack, worldVariant } from '../support/stack.mjs';
 
 // Runs `scanplan args…` against the stack: { code, stdout, stderr }.
-function cli(args, token = stack.token) {
-  return new Promise((resolve) => {
-    const child = spawn(requireEnv('SCANPLAN_CLI'), [...args, '--server', stack.url, '--token', token],
-      { stdio: ['ignore', 'pipe', 'pipe'] });
-    let stdout = '', stderr = '';
-    child.stdout.on('data', (d) => { stdout += d; });
-    child.stderr.on('data', (d) => { stderr += d; });
-    child.on('exit', (code) => resolve({ code, stdout, stderr }));
-  });
-}
+const cli = (args, token) => runCli(stack, args, token);
 
 let stack;
 before(async () => {

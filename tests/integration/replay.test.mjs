@@ -3,11 +3,11 @@
 // one is reported on the progress topic and the bridge keeps going.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { execFileSync, spawn } from 'node:child_process';
+import { execFileSync } from 'node:child_process';
 import { mkdtempSync, writeFileSync, readFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startStack, scanAndWait, requestScan, requireEnv } from '../support/stack.mjs';
+import { startStack, scanAndWait, requestScan, requireEnv, runCli } from '../support/stack.mjs';
 
 const cli = requireEnv('SCANPLAN_CLI');
 const world = join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples/worlds/yard.json');
@@ -68,15 +68,7 @@ test('approving a move the replaying robot cannot make fails with the robot\'s r
     return b.candidates?.length ? b : undefined;
   });
   const id = String(plan.candidates[0].id);
-  const result = await new Promise((resolve) => {
-    const child = spawn(requireEnv('SCANPLAN_CLI'),
-      ['approve', id, '--yes', '--wait', '20', '--server', stack.url, '--token', stack.token],
-      { stdio: ['ignore', 'pipe', 'pipe'] });
-    let stdout = '', stderr = '';
-    child.stdout.on('data', (d) => { stdout += d; });
-    child.stderr.on('data', (d) => { stderr += d; });
-    child.on('exit', (code) => resolve({ code, stdout, stderr }));
-  });
+  const result = await runCli(stack, ['approve', id, '--yes', '--wait', '20']);
   assert.match(result.stdout, new RegExp(`^approved candidate ${id}`));
   assert.equal(result.code, 10, result.stderr);
   assert.match(result.stderr, new RegExp(`robot1 refused to go to candidate ${id}: this robot replays a recording`));

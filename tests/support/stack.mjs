@@ -146,3 +146,16 @@ export async function scanAndWait(stack, count) {
     return s.scans >= count ? s : undefined;
   });
 }
+
+// Runs `scanplan args…` against `stack` (its URL, the given token: the operator's by default)
+// to completion: { code, stdout, stderr }.
+export function runCli(stack, args, token = stack.token) {
+  return new Promise((resolve) => {
+    const child = spawn(requireEnv('SCANPLAN_CLI'), [...args, '--server', stack.url, '--token', token],
+      { stdio: ['ignore', 'pipe', 'pipe'] });
+    let stdout = '', stderr = '';
+    child.stdout.on('data', (d) => { stdout += d; });
+    child.stderr.on('data', (d) => { stderr += d; });
+    child.on('exit', (code) => resolve({ code, stdout, stderr }));
+  });
+}
