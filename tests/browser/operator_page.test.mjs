@@ -78,9 +78,14 @@ test('operator page: map, candidates, approval, growth by WebSocket chunk, recon
     }, target);
     assert.deepEqual(onTop, [0x39, 0xc5, 0xf3], 'the selected candidate is drawn on the top view');
     const detail = await page.locator('#cand-detail').innerText();
+    // Plain words with units first, the paper's score as a detail.
+    assert.match(detail, /new ground\s+≈ [\d,]+ m²/);
+    assert.match(detail, /never scanned\s+[\d,]+ m²/);
+    assert.match(detail, /now coarse\s+[\d,]+ m²/);
+    assert.match(detail, /drive\s+[\d.]+ m/);
+    assert.match(detail, /position\s+-?[\d.]+, -?[\d.]+, -?[\d.]+ m/);
     assert.match(detail, /F \(Eq\. 1\)/);
-    assert.match(detail, /gain unscanned/);
-    assert.match(detail, /drive/);
+    assert.match(await page.locator('#cand-list .cand-row').first().innerText(), /≈ [\d,]+ m²\s+new ground · F [\d,]+\s+[\d.]+ m/);
     // The planner's forecast of matching a scan there (matching is on).
     assert.match(detail, /overlap\s+[\d,]+ m² of the map in view/);
     assert.match(detail, /matching\s+(only )?\d+ % (of the scan )?on the trusted map/);

@@ -58,7 +58,7 @@ test('every suggestion refused: the page says so and offers the operator\'s own 
     await page.click('#confirm-ok');
     await page.waitForFunction(() => document.getElementById('mission-progress').dataset.state === 'finished');
     assert.match(await page.locator('#mission-progress').innerText(), /^mission finished by operator/);
-    assert.equal(await page.locator('#finish-mission').innerText(), 'Resume mission');
+    assert.equal(await page.locator('#finish-mission').innerText(), 'Resume');
     await page.waitForFunction(() => /finished the mission: recording replayed/.test(document.getElementById('log').innerText));
     assert.deepEqual(problems.pageErrors, []);
   });

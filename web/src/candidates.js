@@ -44,6 +44,11 @@ export function candidateName(c) {
   return c.custom ? `custom point #${c.id}` : `candidate ${c.rank} (#${c.id})`;
 }
 
+/** What a scan there would add: never-scanned ground it sees plus coarse ground it completes (m²). */
+export function newGround(c) {
+  return (c.gain_unscanned_m2 || 0) + (c.gain_low_res_m2 || 0);
+}
+
 export class CandidatesPanel {
   /**
    * @param {{list: HTMLElement, detail: HTMLElement, summary: HTMLElement}} els
@@ -153,12 +158,12 @@ export class CandidatesPanel {
       if (this.several) row.append(el('span', 'robot-chip', c.robot));
       row.append(
         el('span', `rank${c.custom ? ' custom' : ''}`, c.custom ? 'C' : String(c.rank)),
-        el('span', 'f', `F ${nf0.format(c.f)}`),
-        el('span', 'gain', `${matchDoubtful(c) ? '⚠ ' : ''}U ${nf0.format(c.gain_unscanned_m2)} · M ${nf0.format(c.gain_low_res_m2)} m²`),
+        el('span', 'f', `≈ ${nf0.format(newGround(c))} m²`),
+        el('span', 'gain', `${matchDoubtful(c) ? '⚠ ' : ''}new ground · F ${nf0.format(c.f)}`),
         el('span', 'travel', `${nf1.format(c.travel_m)} m`),
         el('span', 'chip', STATE_TEXT[c.state] ?? c.state),
       );
-      row.title = `${candidateName(c)}${c.robot ? ` for ${c.robot}` : ''} at (${nf1.format(c.x)}, ${nf1.format(c.y)})${matchDoubtful(c) ? ' — the scan may not match the map' : ''}`;
+      row.title = `${candidateName(c)}${c.robot ? ` for ${c.robot}` : ''} at (${nf1.format(c.x)} m, ${nf1.format(c.y)} m): ≈ ${nf0.format(newGround(c))} m² new ground, ${nf1.format(c.travel_m)} m drive${matchDoubtful(c) ? ' — the scan may not match the map' : ''}`;
       row.addEventListener('click', () => this.select(c.id));
       list.append(row);
     }
@@ -181,11 +186,12 @@ export class CandidatesPanel {
       const title = el('div', 'detail-title', `${candidateName(c)}${this.several ? ` for ${c.robot}` : ''} — ${STATE_TEXT[c.state] ?? c.state}`);
       const grid = el('dl', 'facts');
       const fact = (k, v) => grid.append(el('dt', '', k), el('dd', '', v));
-      fact('F (Eq. 1)', nf1.format(c.f));
-      fact('gain unscanned', `${nf0.format(c.gain_unscanned_m2)} m²`);
-      fact('gain low-res', `${nf0.format(c.gain_low_res_m2)} m²`);
+      fact('new ground', `≈ ${nf0.format(newGround(c))} m²`);
       fact('drive', `${nf1.format(c.travel_m)} m`);
-      fact('position', `x ${nf1.format(c.x)}, y ${nf1.format(c.y)}, z ${nf1.format(c.z)}`);
+      fact('never scanned', `${nf0.format(c.gain_unscanned_m2)} m²`);
+      fact('now coarse', `${nf0.format(c.gain_low_res_m2)} m²`);
+      fact('position', `${nf1.format(c.x)}, ${nf1.format(c.y)}, ${nf1.format(c.z)} m`);
+      fact('F (Eq. 1)', nf1.format(c.f));
       if (c.overlap_m2 > 0) fact('overlap', `${nf0.format(c.overlap_m2)} m² of the map in view`);
       const forecast = matchForecast(c);
       if (forecast) fact('matching', forecast);
@@ -245,7 +251,7 @@ export class CandidatesPanel {
     const robot = c.robot || this.plan?.robot || 'the robot';
     const ok = await confirmAction({
       title: `Approve ${candidateName(c)}?`,
-      body: `${robot} will drive ${nf1.format(c.travel_m)} m to (${nf1.format(c.x)}, ${nf1.format(c.y)}) and scan there. Expected gain: F ${nf0.format(c.f)} (${nf0.format(c.gain_unscanned_m2)} m² unscanned, ${nf0.format(c.gain_low_res_m2)} m² low-resolution).`,
+      body: `${robot} will drive ${nf1.format(c.travel_m)} m to (${nf1.format(c.x)} m, ${nf1.format(c.y)} m) and scan there: about ${nf0.format(newGround(c))} m² of new ground (${nf0.format(c.gain_unscanned_m2)} m² never scanned, ${nf0.format(c.gain_low_res_m2)} m² now only coarse; F ${nf0.format(c.f)}).`,
       confirm: 'Approve and drive',
     });
     if (!ok) return;

@@ -128,7 +128,7 @@ export class Markers {
       g.add(overlay(new Mesh(this.geo.pin, this._mat(color))));
       g.add(overlay(new Mesh(this.geo.head, this._mat(color))));
       const name = `${several ? `${c.robot} ` : ''}${c.custom ? 'custom' : `#${c.rank}`}`;
-      const l = label(`${name} · F ${Math.round(c.f)}`, `cand-label state-${c.state}${c.id === selected ? ' selected' : ''}`);
+      const l = label(`${name} · ≈ ${Math.round((c.gain_unscanned_m2 || 0) + (c.gain_low_res_m2 || 0)).toLocaleString('en-US')} m²`, `cand-label state-${c.state}${c.id === selected ? ' selected' : ''}`);
       l.position.set(0, 0, 3.1);
       g.add(l);
       g.userData.candidate = c.id;

@@ -275,7 +275,7 @@ export class MissionPanel {
     }
     if (finish) {
       finish.hidden = !this.operator || !p;
-      finish.textContent = p?.state === 'finished' ? 'Resume mission' : 'Finish mission…';
+      finish.textContent = p?.state === 'finished' ? 'Resume' : 'Finish…';
     }
   }
 
