@@ -1,10 +1,7 @@
 // LAS 1.4 as ASPRS specifies it (R15, 2019): the public header block, no variable length
 // records, point data record format 7.
 #include <algorithm>
-#include <array>
-#include <bit>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <stdexcept>
 
