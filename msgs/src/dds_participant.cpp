@@ -75,11 +75,11 @@ std::unique_ptr<dds_qos_t, QosDeleter> make_qos(QosKind kind) {
       dds_qset_resource_limits(q.get(), 64, 64, 64);
       break;
     case QosKind::kStatus:
-      // Not only the latest: the topics are keyless (one instance for every robot), and with a
-      // depth of 1 a robot's refusal followed at once by its idle heartbeat, or two robots'
-      // statuses, reached the server as the last one alone — a refused move stayed "driving"
-      // (issue 18). 64 samples are a minute of heartbeats from a dozen robots.
-      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, 64);
+      // Keyed by robot_id, so the depth is per robot: one robot's heartbeats never push out
+      // another's status. Not only the latest: with a depth of 1 a refusal followed at once by
+      // the robot's idle heartbeat reached the server as the heartbeat alone — a refused move
+      // stayed "driving" (issue 18). 16 samples are 16 s of one robot's heartbeats.
+      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, 16);
       // The status writer is how the server knows which robot a bridge speaks for, and its
       // lease is how it knows the bridge is still there.
       dds_qset_liveliness(q.get(), DDS_LIVELINESS_AUTOMATIC,

@@ -3,7 +3,11 @@
 // (DDS's default, infinite) is not matched by a reader that requests one.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdlib>
+#include <map>
+#include <string>
+#include <thread>
 
 #include "scanplan.h"
 #include "scanplan/msgs/dds_participant.hpp"
@@ -83,6 +87,42 @@ TEST_F(DdsQos, AWriterWithoutALeaseIsNotMatchedByTheServersReaders) {
   check(dds_get_requested_incompatible_qos_status(r, &st), "incompatible QoS status");
   EXPECT_GE(st.total_count, 1u);
   EXPECT_EQ(st.last_policy_id, static_cast<std::uint32_t>(DDS_LIVELINESS_QOS_POLICY_ID));
+  dds_delete(w);
+  dds_delete(r);
+}
+
+// Status is keyed by robot: a burst of one robot's heartbeats, far deeper than the history, leaves
+// another robot's refusal in the reader (keyless, it was pushed out and the move stayed "driving").
+TEST_F(DdsQos, OneRobotsHeartbeatsDoNotPushOutAnothersRefusal) {
+  const dds_entity_t w =
+      participant_.writer(scanplan_RobotStatus_desc, topics::kRobotStatus, QosKind::kStatus);
+  const dds_entity_t r =
+      participant_.reader(scanplan_RobotStatus_desc, topics::kRobotStatus, QosKind::kStatus);
+  ASSERT_TRUE(wait_for_reader(w, std::chrono::seconds(5)));
+  auto write = [&](const char* robot, const char* state, std::uint32_t command) {
+    scanplan_RobotStatus s{};
+    s.robot_id = const_cast<char*>(robot);
+    s.command_id = command;
+    s.state = const_cast<char*>(state);
+    s.message = const_cast<char*>("");
+    check(dds_write(w, &s), "dds_write status");
+  };
+  write("robot2", "refused", 7);
+  for (std::uint32_t i = 0; i < 200; ++i) write("robot1", "idle", i);
+  std::map<std::string, std::string> last;
+  int robot1 = 0;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (std::chrono::steady_clock::now() < deadline &&
+         (last["robot1"].empty() || !last.count("robot2"))) {
+    take_all<scanplan_RobotStatus>(r, [&](const scanplan_RobotStatus& s) {
+      last[s.robot_id] = s.state;
+      if (std::string(s.robot_id) == "robot1") ++robot1;
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_EQ(last["robot2"], "refused");
+  EXPECT_EQ(last["robot1"], "idle");
+  EXPECT_LE(robot1, 200);
   dds_delete(w);
   dds_delete(r);
 }
