@@ -342,6 +342,7 @@ std::vector<PlanRecord> LiveMap::refresh_derived(const std::function<void()>& co
   std::vector<PlanRecord> records = make_plans();
   auto layers = render_layers();
   const RegionMap& regions = *mission_.mapping().regions();
+  const auto elevation_m = elevation_range(mission_.mapping().map(), regions);
   const MapAreas areas{regions.completed_m2(), regions.low_resolution_m2(), regions.unscanned_m2(),
                        mission_.mapping().movable()->area_m2()};
   {
@@ -351,6 +352,7 @@ std::vector<PlanRecord> LiveMap::refresh_derived(const std::function<void()>& co
     plans_.replace(records, last_scan_.second);
     layers_ = std::move(layers);
     layer_geometry_ = geometry_of(regions);
+    elevation_range_ = elevation_m;
     areas_ = areas;
     // Only a joining scan has areas "after" it (set_params and rebuild re-segment without one).
     if (commit && scan_joined) areas_after_[last_scan_.first] = areas;
@@ -717,7 +719,8 @@ LayerImage LiveMap::layer(const std::string& name) const {
   std::lock_guard lock(mutex_);
   const auto it = layers_.find(name);
   if (it == layers_.end() || !layer_geometry_) return {};
-  return {it->second, *layer_geometry_};
+  return {it->second, *layer_geometry_,
+          name == "elevation" ? elevation_range_ : std::optional<HeightRange>{}};
 }
 
 std::optional<LayerGeometry> LiveMap::layer_geometry() const {

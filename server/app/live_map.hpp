@@ -19,6 +19,7 @@
 #include "scanplan/geometry/pose.hpp"
 #include "scanplan/geometry/voxel_filter.hpp"
 #include "scanplan/io/map_export.hpp"
+#include "scanplan/mapping/height_range.hpp"
 #include "scanplan/mission/mission_pipeline.hpp"
 #include "scanplan/planning/scan_planner.hpp"
 #include "storage/session_store.hpp"
@@ -41,6 +42,8 @@ struct LayerGeometry {
 struct LayerImage {
   std::shared_ptr<const std::vector<std::uint8_t>> png;  // null before the first scan
   LayerGeometry geometry;
+  // The elevation layer's colour scale: the heights (m) of its first and last colour.
+  std::optional<HeightRange> height_range;
 };
 
 // A goal the operator asked for that the robot cannot be sent to; `code` names the reason
@@ -212,6 +215,7 @@ class LiveMap {
   MapAreas areas_;
   std::map<std::int64_t, MapAreas> areas_after_;  // by scan id
   std::optional<LayerGeometry> layer_geometry_;
+  std::optional<HeightRange> elevation_range_;  // of the elevation layer in layers_
   MissionPipeline mission_;  // written only under encode_mutex_
   const double sensor_height_m_;
   std::pair<std::int64_t, std::string> last_scan_;  // id and robot; under encode_mutex_

@@ -67,6 +67,11 @@ Response Api::layer(const std::string& name) const {
   r.set_header("X-Scanplan-Layer-Bounds", std::to_string(g.min_x) + "," + std::to_string(g.min_y) +
                                               "," + std::to_string(g.max_x) + "," +
                                               std::to_string(g.max_y));
+  // What the elevation layer's colours mean: the heights (m) of the first and last colour.
+  if (image.height_range) {
+    r.set_header("X-Scanplan-Layer-Range", std::to_string(image.height_range->lo) + "," +
+                                               std::to_string(image.height_range->hi));
+  }
   return r;
 }
 

@@ -116,6 +116,13 @@ test('top-view layers come from the MLS map', async () => {
     // The default target region is 200 m square at 4 px a cell.
     const width = new DataView(bytes.buffer).getUint32(16);
     assert.ok(width >= 800 && width <= 808, `${name}.png is ${width} px wide`);
+    // The elevation colours' scale in metres: the yard's ground (0) up to the roof edge (12.5 m).
+    const range = res.headers.get('x-scanplan-layer-range');
+    if (name !== 'elevation') assert.equal(range, null, name);
+    else {
+      const [lo, hi] = range.split(',').map(Number);
+      assert.ok(Math.abs(lo) < 0.3 && hi > 10 && hi < 13, `elevation range ${range}`);
+    }
   }
   const unknown = await stack.api('GET', '/api/v1/layers/heat.png');
   assert.equal(unknown.status, 404);

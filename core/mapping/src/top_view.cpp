@@ -67,7 +67,7 @@ cv::Mat render_regions(const RegionMap& regions, const MovableRegion* movable,
   return img;
 }
 
-cv::Mat render_elevation(const MlsMap& map, const RegionMap& regions, const TopViewStyle& style) {
+std::optional<HeightRange> elevation_range(const MlsMap& map, const RegionMap& regions) {
   float lo = std::numeric_limits<float>::max(), hi = std::numeric_limits<float>::lowest();
   const auto& g = regions.cells;
   for (std::size_t o = 0; o < g.values.size(); ++o) {
@@ -77,7 +77,14 @@ cv::Mat render_elevation(const MlsMap& map, const RegionMap& regions, const TopV
       hi = std::max(hi, cell->dem_height());
     }
   }
-  const float span = hi > lo ? hi - lo : 1.0f;
+  if (lo > hi) return std::nullopt;
+  return HeightRange{lo, hi};
+}
+
+cv::Mat render_elevation(const MlsMap& map, const RegionMap& regions, const TopViewStyle& style) {
+  const HeightRange range = elevation_range(map, regions).value_or(HeightRange{});
+  const float lo = range.lo;
+  const float span = range.hi > range.lo ? range.hi - range.lo : 1.0f;
   cv::Mat level = paint(regions, style, [&](CellIndex c, Region r) {
     const MlsCell* cell = r == Region::kOutside ? nullptr : map.cell(c);
     // Level 0 is kept for "no data"; heights use 1..255.

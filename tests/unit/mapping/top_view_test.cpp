@@ -31,6 +31,21 @@ TEST(TopView, LayersHaveTheTargetsShapeAndColours) {
   EXPECT_EQ(encode_png(render_movable(map, m, r, style))[2], 'N');
 }
 
+// The elevation view's colour scale spans the target's lowest and highest top surface: a 2 m step
+// inside the target counts, one outside it does not, and an empty map has no scale.
+TEST(TopView, TheElevationScaleSpansTheTargetsSurfaces) {
+  MlsMap map;
+  map.insert(slab(0, 20, 0, 10, 0.0f));
+  map.insert(slab(20, 30, 0, 10, 2.0f));
+  map.insert(slab(60, 70, 0, 10, 9.0f));
+  const RegionMap r = segment_regions(map, TargetRegion::rectangle({0, 0}, {40, 10}), {{0.5, 0.5}});
+  const auto range = elevation_range(map, r);
+  ASSERT_TRUE(range);
+  EXPECT_NEAR(range->lo, 0.0f, 0.05f);
+  EXPECT_NEAR(range->hi, 2.0f, 0.05f);
+  EXPECT_FALSE(elevation_range(MlsMap{}, r));
+}
+
 TEST(TopView, ACaptionedViewKeepsTheMapAndAddsTitleLegendAndScale) {
   MlsMap map;
   map.insert(slab(0, 30, 0, 10, 0.0f));

@@ -3,9 +3,11 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "scanplan/mapping/height_range.hpp"
 #include "scanplan/mapping/movable_region.hpp"
 #include "scanplan/mapping/region_segmentation.hpp"
 
@@ -24,8 +26,12 @@ cv::Mat render_regions(const RegionMap& regions, const MovableRegion* movable,
                        const std::vector<Eigen::Vector2d>& scan_points,
                        const TopViewStyle& style = {});
 
-// Height of the highest surface per cell (the DEM view), colour-mapped between the lowest and
-// highest cell of the target region; cells without data black.
+// The lowest and highest top surface (the DEM height) of the target region's cells with data, in
+// metres: the ends of the elevation view's colour scale. Nothing when no cell has data.
+std::optional<HeightRange> elevation_range(const MlsMap& map, const RegionMap& regions);
+
+// Height of the highest surface per cell (the DEM view), colour-mapped (turbo) over
+// elevation_range; cells without data black.
 cv::Mat render_elevation(const MlsMap& map, const RegionMap& regions,
                          const TopViewStyle& style = {});
 
