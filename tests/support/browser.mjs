@@ -24,16 +24,22 @@ export const CHROMIUM_ARGS = [
   '--enable-unsafe-swiftshader',
 ];
 
-/** A fresh browser profile; `fn(context)`; everything is closed and removed afterwards. */
-export async function withBrowser(fn) {
+/**
+ * A fresh browser profile; `fn(context)`; everything is closed and removed afterwards.
+ * `viewport` (default the field laptop's) and `touch` (a touch screen: taps, pinches, coarse
+ * pointer) choose the device.
+ */
+export async function withBrowser(fn, { viewport = VIEWPORT, touch = false } = {}) {
   const { chromium } = require('playwright-core');
   const profile = mkdtempSync(join(tmpdir(), 'scanplan-chromium-'));
   const context = await chromium.launchPersistentContext(profile, {
     executablePath: CHROMIUM,
     headless: true,
     args: CHROMIUM_ARGS,
-    viewport: VIEWPORT,
+    viewport,
     deviceScaleFactor: 1,
+    hasTouch: touch,
+    isMobile: false,
     timeout: 30000,
   });
   try {

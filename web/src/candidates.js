@@ -4,6 +4,7 @@
 // Viewers see no buttons.
 import { sendJson } from './api.js';
 import { confirmAction } from './dialog.js';
+import { robotColor } from './robot_colors.js';
 
 const nf0 = new Intl.NumberFormat('en-US', { maximumFractionDigits: 0 });
 // The planner's forecast of matching a scan at the candidate (docs/planner.md): whether the
@@ -155,7 +156,11 @@ export class CandidatesPanel {
       row.dataset.id = String(c.id);
       row.dataset.state = c.state;
       if (c.robot) row.dataset.robot = c.robot;
-      if (this.several) row.append(el('span', 'robot-chip', c.robot));
+      if (this.several) {
+        const chip = el('span', 'robot-chip', c.robot);
+        chip.style.color = robotColor(c.robot);
+        row.append(chip);
+      }
       row.append(
         el('span', `rank${c.custom ? ' custom' : ''}`, c.custom ? 'C' : String(c.rank)),
         el('span', 'f', `≈ ${nf0.format(newGround(c))} m²`),

@@ -55,7 +55,7 @@ export class CoverageChart {
       this.readout.textContent = '';
       return;
     }
-    const L = 40, R = 30, T = 6, B = 16;
+    const L = 40, R = 30, T = 14, B = 16;
     const pw = w - L - R;
     const ph = h - T - B;
     const data = ids.map((id) => this.points.get(id));
@@ -79,6 +79,13 @@ export class CoverageChart {
     }
     ctx.textAlign = 'left';
     for (const p of [0, 50, 100]) ctx.fillText(`${p}%`, L + pw + 4, T + ph - (p / 100) * ph);
+    // The axes' units: scanned area (m²) left, unscanned share right, scans along the bottom.
+    ctx.textBaseline = 'top';
+    ctx.fillText('m² scanned', 2, 0);
+    ctx.textAlign = 'right';
+    ctx.fillText('U %', w - 2, 0);
+    ctx.textBaseline = 'top';
+    ctx.fillText('scan', L - 4, T + ph + 3);
 
     // Bars: C below, M on top.
     const slot = pw / ids.length;

@@ -4,6 +4,7 @@
 // does not hold.
 import './style.css';
 import { AnnotationsPanel } from './annotations.js';
+import { AreaEditor } from './area_editor.js';
 import { apiFetch, getJson, getToken, initToken } from './api.js';
 import { CandidatesPanel } from './candidates.js';
 import { CoverageChart } from './chart.js';
@@ -15,6 +16,7 @@ import { DecisionLog } from './log.js';
 import { MapChunks } from './map_chunks.js';
 import { Markers } from './markers.js';
 import { MeasureTool } from './measure.js';
+import { setRobotIds } from './robot_colors.js';
 import { MissionPanel } from './mission.js';
 import { TopView, parseLayerBounds } from './top_view.js';
 import { MapView } from './view.js';
@@ -22,7 +24,7 @@ import { MapView } from './view.js';
 const POLL_MS = 10000; // the session, as a link check and for robot poses between events
 const LAYER_LEGENDS = {
   regions: [['#fad6b4', 'C completed'], ['#ecd040', 'M low-res, movable'], ['#466ec8', 'M not movable'], ['#404040', 'U unscanned']],
-  elevation: [['linear-gradient(90deg,#30123b,#28bbec,#a2fc3c,#fb8022,#7a0403)', 'low → high']],
+  elevation: [['linear-gradient(90deg,#30123b,#28bbec,#a2fc3c,#fb8022,#7a0403)', 'low → high (top surface)']],
   movable: [['#5abe5a', 'movable'], ['#969696', 'data, not movable'], ['#404040', 'no data']],
 };
 
@@ -40,6 +42,7 @@ const state = {
   error: null, // an error of the session or auth, shown in the top bar
   pollFailures: 0,
   layer: 'regions',
+  layerRange: null, // [lo, hi] m of the elevation layer's colours
   tool: null, // null | measure | annotate
   resumedAt: 0,
   resumeScans: 0,
@@ -82,9 +85,30 @@ const topView = new TopView($('top-canvas'), {
   onSelect: (id) => candidates.select(id),
   onMapClick: (x, y) => goals.set({ x, y }),
   onHover: (p) => {
-    $('top-coords').textContent = p ? `x ${p.x.toFixed(1)}  y ${p.y.toFixed(1)}` : '';
+    $('top-coords').textContent = p ? `x ${p.x.toFixed(1)} m  y ${p.y.toFixed(1)} m` : '';
   },
 });
+
+const area = new AreaEditor(
+  {
+    edit: $('area-edit'),
+    bar: $('area-bar'),
+    drawArea: $('area-draw'),
+    addZone: $('area-zone'),
+    undo: $('area-undo'),
+    close: $('area-close'),
+    reset: $('area-reset'),
+    save: $('area-save'),
+    cancel: $('area-cancel'),
+    zones: $('area-zones'),
+    msg: $('area-msg'),
+  },
+  {
+    topView,
+    // Clicks on the top view draw corners now, not scan points.
+    onEditing: (on) => on && goals.set(null),
+  },
+);
 
 const candidates = new CandidatesPanel(
   { list: $('cand-list'), detail: $('cand-detail'), summary: $('cand-summary') },
@@ -228,6 +252,7 @@ function applyRole(role) {
   const operator = role === 'operator';
   candidates.setRole(operator);
   goals.setRole(operator);
+  area.setRole(operator);
   mission.setRole(operator);
   annotations.setRole(operator);
   excluded.setRole(operator);
@@ -338,6 +363,8 @@ async function refreshLayer() {
           continue;
         }
         const bounds = parseLayerBounds(res.headers.get('X-Scanplan-Layer-Bounds'));
+        const range = (res.headers.get('X-Scanplan-Layer-Range') || '').split(',').map(Number);
+        if (name === state.layer) state.layerRange = range.length === 2 && range.every(Number.isFinite) ? range : null;
         const blob = await res.blob();
         const image = await createImageBitmap(blob);
         if (name === state.layer) topView.setLayer(image, bounds);
@@ -357,7 +384,13 @@ async function refreshLayer() {
 function renderLegend() {
   const legend = $('top-legend');
   legend.replaceChildren();
-  for (const [color, label] of LAYER_LEGENDS[state.layer] || []) {
+  for (let [color, label] of LAYER_LEGENDS[state.layer] || []) {
+    // The elevation colours in metres: the lowest and highest top surface of the area.
+    if (state.layer === 'elevation' && state.layerRange) {
+      const [lo, hi] = state.layerRange;
+      const m = (v) => `${(Math.abs(v) < 0.05 ? 0 : v).toFixed(1)} m`;
+      label = `${m(lo)} → ${m(hi)} (top surface)`;
+    }
     const item = document.createElement('span');
     const sw = document.createElement('i');
     sw.className = color.startsWith('linear') ? 'sw wide' : 'sw';
@@ -380,13 +413,19 @@ async function refreshDecisions() {
 async function resync() {
   await refreshSession();
   if (state.error?.auth) return;
-  await Promise.all([refreshScans(), refreshCandidates(), refreshLayer(), refreshDecisions(), annotations.load()]);
+  await Promise.all([refreshScans(), refreshCandidates(), refreshLayer(), refreshDecisions(), annotations.load(), area.load()]);
 }
 
 // ---------------------------------------------------------------- robot, path
 function updateRobot() {
   const robots = state.session?.robots || {};
   const ids = Object.keys({ ...robots, ...mission.robots }).sort();
+  if (setRobotIds([...ids, ...candidates.list.map((c) => c.robot)])) {
+    // A robot joined: colours follow the sorted ids, so every panel draws again.
+    candidates.render();
+    mission.render();
+    markers?.setCandidates(candidates.list, candidates.selected);
+  }
   const placed = ids.map((id) => ({ id, pose: mission.robotPose(id) }));
   markers?.setRobots(placed);
   topView.setRobots(placed);
@@ -463,6 +502,7 @@ function onEvent(e) {
     case 'mission':
       log.add(e);
       refreshCandidates();
+      if (e.kind === 'params') area.load();
       break;
     case 'annotation':
       annotations.onEvent(e);
@@ -573,6 +613,7 @@ applySize();
 
 $('layer-select').addEventListener('change', (e) => {
   state.layer = e.target.value;
+  state.layerRange = null;
   renderLegend();
   refreshLayer();
 });
@@ -593,6 +634,7 @@ window.addEventListener('keydown', (ev) => {
     measure?.clear();
     annotations.closeForm();
     goals.set(null);
+    if (area.drawing) area.dropShape();
     if (state.tool) setTool(state.tool);
   }
 });
@@ -612,4 +654,4 @@ if (state.error) {
 setInterval(refreshSession, POLL_MS);
 
 // For the console and for tests.
-window.scanplan = { view, state, chunks, events, topView, candidates, annotations, measure, chart, log, mission };
+window.scanplan = { view, state, chunks, events, topView, candidates, annotations, measure, chart, log, mission, area };

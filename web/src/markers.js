@@ -1,7 +1,10 @@
 // What is drawn over the points in the 3-D view: scan positions, the planner's candidates (rank and
 // F), the robot, the approved path and annotations. Drawn without depth test so buildings never hide
-// them; labels are HTML (CSS2DRenderer). Shared geometries and materials are made once and disposed
-// with the markers; groups are rebuilt when their data changes.
+// them; labels are HTML (CSS2DRenderer), decluttered after each render: where two overlap on
+// screen the more important one stays (the selected candidate, robots, annotations, then the
+// candidates by rank, then scans), so labels never pile up into an unreadable heap. Shared
+// geometries and materials are made once and disposed with the markers; groups are rebuilt when
+// their data changes.
 import {
   BoxGeometry,
   BufferGeometry,
@@ -16,6 +19,7 @@ import {
   Vector3,
 } from 'three';
 import { CSS2DObject } from 'three/addons/renderers/CSS2DRenderer.js';
+import { robotColor, robotColorInt } from './robot_colors.js';
 import { scanColor } from './view.js';
 
 export const STATE_COLORS = {
@@ -30,13 +34,15 @@ export const STATE_COLORS = {
 };
 export const SELECTED_COLOR = 0x39c5f3;
 export const ANNOTATION_COLORS = { victim: 0xff4d6d, hazard: 0xff9f1c, blocked: 0xb388ff, note: 0x4dabf7 };
-const ROBOT_COLOR = 0xff7b29;
 const OVERLAY_ORDER = 10;
+// Which label stays where two overlap (higher wins).
+const PRIORITY = { selected: 100, robot: 90, annotation: 80, custom: 60, candidate: 50, scan: 10 };
 
-function label(text, className) {
+function label(text, className, priority) {
   const el = document.createElement('div');
   el.className = `marker-label ${className}`;
   el.textContent = text;
+  el.dataset.priority = String(priority);
   return new CSS2DObject(el);
 }
 
@@ -72,6 +78,24 @@ export class Markers {
     };
     this.materials = new Map(); // colour -> material
     this.lineMaterials = [];
+    view.afterRender = () => this.declutter();
+  }
+
+  /** Hides each label that overlaps a more important one on screen (see PRIORITY). */
+  declutter() {
+    const items = [];
+    for (const el of this.view.labels.domElement.querySelectorAll('.marker-label')) {
+      if (el.style.display === 'none') continue; // behind the camera
+      items.push({ el, priority: Number(el.dataset.priority) || 0 });
+    }
+    items.sort((a, b) => b.priority - a.priority);
+    const kept = [];
+    for (const { el } of items) {
+      const r = el.getBoundingClientRect();
+      const covered = kept.some((k) => r.left < k.right && r.right > k.left && r.top < k.bottom && r.bottom > k.top);
+      el.classList.toggle('cluttered', covered);
+      if (!covered) kept.push(r);
+    }
   }
 
   _mat(color) {
@@ -107,7 +131,7 @@ export class Markers {
       const color = (Math.round(r * 255) << 16) | (Math.round(g * 255) << 8) | Math.round(b * 255);
       const m = overlay(new Mesh(this.geo.disc, this._mat(color)));
       m.position.set(s.placed.x, s.placed.y, s.placed.z + 0.06);
-      const l = label(`S${s.id}`, 'scan-label');
+      const l = label(`S${s.id}`, 'scan-label', PRIORITY.scan);
       l.position.set(0, 0, 0.4);
       m.add(l);
       this.groups.scans.add(m);
@@ -128,7 +152,9 @@ export class Markers {
       g.add(overlay(new Mesh(this.geo.pin, this._mat(color))));
       g.add(overlay(new Mesh(this.geo.head, this._mat(color))));
       const name = `${several ? `${c.robot} ` : ''}${c.custom ? 'custom' : `#${c.rank}`}`;
-      const l = label(`${name} · ≈ ${Math.round((c.gain_unscanned_m2 || 0) + (c.gain_low_res_m2 || 0)).toLocaleString('en-US')} m²`, `cand-label state-${c.state}${c.id === selected ? ' selected' : ''}`);
+      const priority = c.id === selected ? PRIORITY.selected : c.custom ? PRIORITY.custom : PRIORITY.candidate - Math.min(c.rank || 0, 40);
+      const l = label(`${name} · ≈ ${Math.round((c.gain_unscanned_m2 || 0) + (c.gain_low_res_m2 || 0)).toLocaleString('en-US')} m²`, `cand-label state-${c.state}${c.id === selected ? ' selected' : ''}`, priority);
+      if (several && c.robot) l.element.style.borderLeft = `4px solid ${robotColor(c.robot)}`;
       l.position.set(0, 0, 3.1);
       g.add(l);
       g.userData.candidate = c.id;
@@ -161,9 +187,11 @@ export class Markers {
     for (const { id, pose } of robots) {
       if (!pose || !Number.isFinite(pose.x)) continue;
       const g = new Group();
-      g.add(overlay(new Mesh(this.geo.body, this._mat(ROBOT_COLOR))));
-      g.add(overlay(new Mesh(this.geo.nose, this._mat(ROBOT_COLOR))));
-      const l = label(id, 'robot-label');
+      const color = robotColorInt(id);
+      g.add(overlay(new Mesh(this.geo.body, this._mat(color))));
+      g.add(overlay(new Mesh(this.geo.nose, this._mat(color))));
+      const l = label(id, 'robot-label', PRIORITY.robot);
+      l.element.style.borderColor = robotColor(id);
       l.position.set(0, 0, 1.1);
       g.add(l);
       g.position.set(pose.x, pose.y, pose.z || 0);
@@ -181,7 +209,7 @@ export class Markers {
       const m = overlay(new Mesh(this.geo.dot, this._mat(color)));
       m.position.set(a.x, a.y, a.z);
       const text = a.text ? `${a.kind}: ${a.text}` : a.kind;
-      const l = label(text.length > 40 ? `${text.slice(0, 39)}…` : text, `annot-label kind-${a.kind}`);
+      const l = label(text.length > 40 ? `${text.slice(0, 39)}…` : text, `annot-label kind-${a.kind}`, PRIORITY.annotation);
       l.position.set(0, 0, 0.6);
       m.add(l);
       this.groups.annotations.add(m);
@@ -190,6 +218,7 @@ export class Markers {
   }
 
   dispose() {
+    if (this.view.afterRender) this.view.afterRender = null;
     for (const name of Object.keys(this.groups)) this._clear(name);
     this.view.overlay.remove(this.root);
     for (const g of Object.values(this.geo)) g.dispose();

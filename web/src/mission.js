@@ -4,6 +4,7 @@
 // operator's "scan here" (POST /api/v1/scan, confirmed first).
 import { sendJson } from './api.js';
 import { confirmAction } from './dialog.js';
+import { robotColor } from './robot_colors.js';
 
 const nf0 = new Intl.NumberFormat('en-US', { maximumFractionDigits: 0 });
 const f2 = (v) => (Number.isFinite(v) ? v.toFixed(2) : '–');
@@ -180,6 +181,8 @@ export class MissionPanel {
       line.className = 'robot-line';
       const name = document.createElement('b');
       name.textContent = id;
+      name.className = 'robot-name';
+      name.style.setProperty('--robot', robotColor(id));
       const chip = document.createElement('span');
       const lost = r.connected === false;
       chip.className = lost ? 'chip robot-lost' : `chip robot-${r.state}`;

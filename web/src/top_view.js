@@ -1,10 +1,14 @@
 // Top view: a region layer of the server (GET /api/v1/layers/{regions,elevation,movable}.png, placed
 // in the map by its X-Scanplan-Layer-Bounds header) with the scan points, candidates and their travel
-// paths, the robot and annotations drawn over it. Wheel zooms about the cursor, dragging pans; a
-// click selects the candidate under it, or else reports the map position (to propose a goal there).
+// paths, the robots, annotations, the target area and the no-go zones drawn over it. Wheel or a
+// two-finger pinch zooms, dragging pans; a click (or tap) selects the candidate under it, or else
+// reports the map position (to propose a goal there). While the area is edited, clicks and corner
+// drags go to the area editor.
 import { ANNOTATION_COLORS, SELECTED_COLOR, STATE_COLORS } from './markers.js';
+import { robotColor } from './robot_colors.js';
 
-const HIT_PX = 11;
+const coarse = () => window.matchMedia?.('(pointer: coarse)').matches;
+const hitPx = () => (coarse() ? 22 : 11); // a finger needs a larger target than a mouse
 const hex = (c) => `#${c.toString(16).padStart(6, '0')}`;
 
 export class TopView {
@@ -27,6 +31,7 @@ export class TopView {
     this.robots = [];
     this.annotations = [];
     this.pending = null; // {x, y}: a point the operator clicked, before proposing it
+    this.area = null; // the AreaEditor: the shapes to draw, and clicks while editing
     this.dataBounds = null;
     this.scale = 4; // CSS px per metre
     this.cx = 0;
@@ -124,6 +129,12 @@ export class TopView {
     this.redraw();
   }
 
+  /** @param {import('./area_editor.js').AreaEditor} editor */
+  setAreaEditor(editor) {
+    this.area = editor;
+    this.redraw();
+  }
+
   /** Frames the data (or the whole layer) with a margin. */
   fit() {
     let b = this.dataBounds ? { ...this.dataBounds } : null;
@@ -153,61 +164,108 @@ export class TopView {
 
   _installInput() {
     const c = this.canvas;
+    const pointers = new Map(); // pointerId -> {x, y} (client px): two of them pinch
     let drag = null;
-    c.addEventListener('wheel', (e) => {
-      e.preventDefault();
+    let pinch = null;
+    const local = (e) => {
       const r = c.getBoundingClientRect();
-      const px = e.clientX - r.left;
-      const py = e.clientY - r.top;
+      return { px: e.clientX - r.left, py: e.clientY - r.top };
+    };
+    const zoomAbout = (px, py, k) => {
       const before = this.mapOf(px, py);
-      const k = Math.exp(-e.deltaY * 0.0015);
       this.scale = Math.min(80, Math.max(0.2, this.scale * k));
       const after = this.mapOf(px, py);
       this.cx += before.x - after.x;
       this.cy += before.y - after.y;
       this.userMoved = true;
       this.redraw();
+    };
+    const startPinch = () => {
+      const [a, b] = [...pointers.values()];
+      pinch = { d: Math.max(1, Math.hypot(a.x - b.x, a.y - b.y)), mx: (a.x + b.x) / 2, my: (a.y + b.y) / 2 };
+      drag = null; // a second finger turns a tap or drag into a pinch
+    };
+    c.addEventListener('wheel', (e) => {
+      e.preventDefault();
+      const { px, py } = local(e);
+      zoomAbout(px, py, Math.exp(-e.deltaY * 0.0015));
     }, { passive: false });
     c.addEventListener('pointerdown', (e) => {
-      if (e.button !== 0) return;
+      if (e.pointerType === 'mouse' && e.button !== 0) return;
       c.setPointerCapture(e.pointerId);
-      drag = { x: e.clientX, y: e.clientY, cx: this.cx, cy: this.cy, moved: false };
+      pointers.set(e.pointerId, { x: e.clientX, y: e.clientY });
+      if (pointers.size === 2) {
+        startPinch();
+        return;
+      }
+      if (pointers.size > 2) return;
+      const { px, py } = local(e);
+      const handle = this.area?.handleAt(px, py) ?? null;
+      drag = { x: e.clientX, y: e.clientY, cx: this.cx, cy: this.cy, moved: false, handle };
     });
     c.addEventListener('pointermove', (e) => {
-      const r = c.getBoundingClientRect();
-      this.onHover?.(this.mapOf(e.clientX - r.left, e.clientY - r.top));
+      const { px, py } = local(e);
+      if (e.pointerType === 'mouse') this.onHover?.(this.mapOf(px, py));
+      if (pointers.has(e.pointerId)) pointers.set(e.pointerId, { x: e.clientX, y: e.clientY });
+      if (pinch && pointers.size === 2) {
+        const [a, b] = [...pointers.values()];
+        const d = Math.max(1, Math.hypot(a.x - b.x, a.y - b.y));
+        const mx = (a.x + b.x) / 2;
+        const my = (a.y + b.y) / 2;
+        // Pan with the fingers' midpoint, zoom about it by the change of their distance.
+        this.cx -= (mx - pinch.mx) / this.scale;
+        this.cy += (my - pinch.my) / this.scale;
+        const r = c.getBoundingClientRect();
+        zoomAbout(mx - r.left, my - r.top, d / pinch.d);
+        pinch = { d, mx, my };
+        return;
+      }
       if (!drag) return;
       const dx = e.clientX - drag.x;
       const dy = e.clientY - drag.y;
-      if (!drag.moved && Math.hypot(dx, dy) < 4) return;
+      if (!drag.moved && Math.hypot(dx, dy) < (e.pointerType === 'mouse' ? 4 : 8)) return;
       drag.moved = true;
+      if (drag.handle) {
+        this.area.moveHandle(drag.handle, this.mapOf(px, py));
+        return;
+      }
       this.cx = drag.cx - dx / this.scale;
       this.cy = drag.cy + dy / this.scale;
       this.userMoved = true;
       this.redraw();
     });
-    c.addEventListener('pointerleave', () => this.onHover?.(null));
+    c.addEventListener('pointerleave', (e) => {
+      if (e.pointerType === 'mouse') this.onHover?.(null);
+    });
+    const release = (e) => {
+      pointers.delete(e.pointerId);
+      if (pointers.size < 2) pinch = null;
+    };
+    c.addEventListener('pointercancel', (e) => {
+      release(e);
+      drag = null;
+    });
     c.addEventListener('pointerup', (e) => {
+      release(e);
       if (!drag) return;
       const wasDrag = drag.moved;
       drag = null;
       if (wasDrag) return;
-      const r = c.getBoundingClientRect();
-      const px = e.clientX - r.left;
-      const py = e.clientY - r.top;
+      const { px, py } = local(e);
+      const p = this.mapOf(px, py);
+      // A tap shows where it was, as the mouse's hover does.
+      if (e.pointerType !== 'mouse') this.onHover?.(p);
+      if (this.area?.click(p)) return;
       const hit = this.candidateAt(px, py);
       if (hit) this.onSelect(hit.id);
-      else {
-        const p = this.mapOf(px, py);
-        this.onMapClick(p.x, p.y);
-      }
+      else this.onMapClick(p.x, p.y);
     });
   }
 
   /** The candidate drawn nearest (px, py), within a few pixels. */
   candidateAt(px, py) {
     let best = null;
-    let bestD = HIT_PX;
+    let bestD = hitPx();
     for (const cand of this.candidates) {
       if (cand.state === 'superseded') continue;
       const s = this.screenOf(cand.x, cand.y);
@@ -234,6 +292,7 @@ export class TopView {
       ctx.imageSmoothingEnabled = this.scale * (this.bounds.maxX - this.bounds.minX) < this.image.width;
       ctx.drawImage(this.image, a.x, a.y, b.x - a.x, b.y - a.y);
     }
+    this._drawArea(ctx);
     this._drawScale(ctx, h);
 
     // Travel paths: the selected candidate's bold, a moving one green, the others faint.
@@ -270,6 +329,7 @@ export class TopView {
 
     // Candidates: rank in a circle (custom ones a diamond), coloured by state.
     const order = [...this.candidates].sort((a, b) => (a.id === this.selected) - (b.id === this.selected));
+    const several = new Set(this.candidates.map((c) => c.robot)).size > 1;
     for (const cand of order) {
       if (cand.state === 'superseded') continue;
       const p = this.screenOf(cand.x, cand.y);
@@ -291,6 +351,14 @@ export class TopView {
       ctx.lineWidth = selected ? 2.5 : 1.5;
       ctx.strokeStyle = '#0d1117';
       ctx.stroke();
+      if (several && cand.robot) {
+        // Whose candidate: a ring in its robot's colour.
+        ctx.beginPath();
+        ctx.arc(p.x, p.y, r + 3, 0, Math.PI * 2);
+        ctx.lineWidth = 2.5;
+        ctx.strokeStyle = robotColor(cand.robot);
+        ctx.stroke();
+      }
       ctx.fillStyle = '#0d1117';
       ctx.textAlign = 'center';
       ctx.fillText(cand.custom ? 'C' : String(cand.rank), p.x, p.y + 0.5);
@@ -319,7 +387,7 @@ export class TopView {
       ctx.lineTo(-3, 0);
       ctx.lineTo(-7, -7);
       ctx.closePath();
-      ctx.fillStyle = '#ff7b29';
+      ctx.fillStyle = robotColor(id);
       ctx.fill();
       ctx.lineWidth = 1.5;
       ctx.strokeStyle = '#0d1117';
@@ -334,7 +402,7 @@ export class TopView {
         // Alternately above and below, so robots side by side keep readable names.
         const dy = k % 2 ? 13 : -13;
         ctx.strokeText(id, p.x + 8, p.y + dy);
-        ctx.fillStyle = '#ffb27a';
+        ctx.fillStyle = robotColor(id);
         ctx.fillText(id, p.x + 8, p.y + dy);
       }
     }
@@ -353,6 +421,91 @@ export class TopView {
       ctx.arc(p.x, p.y, 6, 0, Math.PI * 2);
       ctx.stroke();
     }
+  }
+
+  _polygonPath(ctx, poly, close = true) {
+    ctx.beginPath();
+    poly.forEach(([x, y], i) => {
+      const s = this.screenOf(x, y);
+      if (i === 0) ctx.moveTo(s.x, s.y);
+      else ctx.lineTo(s.x, s.y);
+    });
+    if (close) ctx.closePath();
+  }
+
+  // The target area (cyan outline; the default square dashed grey), the no-go zones (red, hatched)
+  // and, while editing, every corner as a handle and the shape being drawn.
+  _drawArea(ctx) {
+    const shapes = this.area?.shapes();
+    if (!shapes) return;
+    const { target, noGo, drawing, editing } = shapes;
+    ctx.save();
+    if (target) {
+      this._polygonPath(ctx, target);
+      ctx.setLineDash([]);
+      ctx.lineWidth = 2;
+      ctx.strokeStyle = '#39c5f3';
+      ctx.stroke();
+    } else if (this.bounds && editing) {
+      const { minX, minY, maxX, maxY } = this.bounds;
+      this._polygonPath(ctx, [[minX, minY], [maxX, minY], [maxX, maxY], [minX, maxY]]);
+      ctx.setLineDash([6, 5]);
+      ctx.lineWidth = 1.5;
+      ctx.strokeStyle = 'rgba(230,237,243,0.6)';
+      ctx.stroke();
+    }
+    if (!this._hatch) {
+      const tile = document.createElement('canvas');
+      tile.width = tile.height = 8;
+      const t = tile.getContext('2d');
+      t.strokeStyle = 'rgba(248,81,73,0.55)';
+      t.lineWidth = 1.5;
+      t.beginPath();
+      t.moveTo(0, 8);
+      t.lineTo(8, 0);
+      t.stroke();
+      this._hatch = ctx.createPattern(tile, 'repeat');
+    }
+    ctx.setLineDash([]);
+    for (const zone of noGo) {
+      this._polygonPath(ctx, zone);
+      ctx.fillStyle = 'rgba(248,81,73,0.18)';
+      ctx.fill();
+      ctx.fillStyle = this._hatch;
+      ctx.fill();
+      ctx.lineWidth = 2;
+      ctx.strokeStyle = '#f85149';
+      ctx.stroke();
+    }
+    if (editing) {
+      for (const poly of [target, ...noGo]) {
+        if (!poly) continue;
+        for (const [x, y] of poly) {
+          const s = this.screenOf(x, y);
+          ctx.fillStyle = '#e6edf3';
+          ctx.fillRect(s.x - 4, s.y - 4, 8, 8);
+          ctx.strokeStyle = '#0d1117';
+          ctx.lineWidth = 1;
+          ctx.strokeRect(s.x - 4, s.y - 4, 8, 8);
+        }
+      }
+    }
+    if (drawing && drawing.corners.length) {
+      this._polygonPath(ctx, drawing.corners, false);
+      ctx.setLineDash([5, 4]);
+      ctx.lineWidth = 2;
+      ctx.strokeStyle = drawing.kind === 'area' ? '#39c5f3' : '#f85149';
+      ctx.stroke();
+      ctx.setLineDash([]);
+      drawing.corners.forEach(([x, y], i) => {
+        const s = this.screenOf(x, y);
+        ctx.beginPath();
+        ctx.arc(s.x, s.y, i === 0 ? 6 : 4, 0, Math.PI * 2);
+        ctx.fillStyle = i === 0 ? '#e6edf3' : ctx.strokeStyle;
+        ctx.fill();
+      });
+    }
+    ctx.restore();
   }
 
   _drawScale(ctx, h) {

@@ -137,6 +137,7 @@ export class MapView {
     this.dirty = true;
     this.drawn = 0;
     this.onClick = null; // (event, pick) for tools
+    this.afterRender = null; // called after each drawn frame (the markers declutter their labels)
     this.onLodChange = null;
 
     this._installClick();
@@ -400,7 +401,7 @@ export class MapView {
       const moved = Math.hypot(e.clientX - down.x, e.clientY - down.y);
       const quick = performance.now() - down.t < 600;
       down = null;
-      if (moved <= 4 && quick && this.onClick) this.onClick(e);
+      if (moved <= (e.pointerType === 'mouse' ? 4 : 10) && quick && this.onClick) this.onClick(e);
     });
   }
 
@@ -410,6 +411,7 @@ export class MapView {
       this.dirty = false;
       this.renderer.render(this.scene, this.camera);
       this.labels.render(this.scene, this.camera);
+      this.afterRender?.();
     }
   }
 
