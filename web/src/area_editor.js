@@ -180,7 +180,8 @@ export class AreaEditor {
       this.draft = null;
       this.drawing = null;
       const zones = this.saved.no_go.length;
-      this.say(`Saved: ${this.saved.target ? 'the drawn area' : 'the default area'}${zones ? `, ${zones} no-go zone${zones > 1 ? 's' : ''}` : ''}; new candidates follow.`);
+      const areaText = this.saved.target ? `an area of ${nf1.format(Math.abs(polygonArea(this.saved.target)))} m²` : 'the default area';
+      this.say(`Saved: ${areaText}${zones ? `, ${zones} no-go zone${zones > 1 ? 's' : ''}` : ''}; new candidates follow.`);
       this.onEditing(false);
     } catch (e) {
       this.busy = false;

@@ -498,6 +498,8 @@ function onEvent(e) {
     case 'plan_done':
       refreshCandidates();
       refreshLayer();
+      // The mission's progress line (the best candidate's gain, the estimate) follows the plan.
+      refreshSession();
       break;
     case 'mission':
       log.add(e);
