@@ -137,7 +137,7 @@ LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
   // (the completed radius, paper §3.3: what a scan completes).
   if (f.in_map.back()) {
     const Pose& at = f.scans.back().placed;
-    plans_.forget_refusals_near(at.x, at.y, mission_.planner().regions.completed_radius_m);
+    plans_.forget_refusals_near(at.x, at.y, mission_.planner().regions.completed_radius_m, scan.id);
   }
   Added out;
   out.corrected = f.corrected;

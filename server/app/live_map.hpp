@@ -216,7 +216,7 @@ class LiveMap {
   std::map<std::int64_t, MapAreas> areas_after_;  // by scan id
   std::optional<LayerGeometry> layer_geometry_;
   std::optional<HeightRange> elevation_range_;  // of the elevation layer in layers_
-  MissionPipeline mission_;  // written only under encode_mutex_
+  MissionPipeline mission_;                     // written only under encode_mutex_
   const double sensor_height_m_;
   std::pair<std::int64_t, std::string> last_scan_;  // id and robot; under encode_mutex_
   std::map<std::string, Pose> scan_pose_of_;  // each robot's last scan pose; under encode_mutex_

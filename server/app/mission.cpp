@@ -15,16 +15,24 @@ using nlohmann::json;
 Mission::Mission(LiveMap& map, PlanBook& plans, const RobotBoard& robots, RobotLink& link,
                  SessionStore& session, const Events& events)
     : map_(map), plans_(plans), robots_(robots), link_(link), session_(session), events_(events) {
-  // Whether the operator finished the mission before a restart: the last finish or resume.
+  // What the log says of the mission before a restart: whether the operator finished it (the
+  // last finish or resume) and the points each robot refused, kept until a scan after the
+  // refusal changes the map near them (the scans reload after this, see PlanBook).
   try {
     for (const SessionEvent& e : session_.events(1000000)) {
       if (e.kind == "resume") finished_.reset();
-      if (e.kind != "finish") continue;
+      if (e.kind != "finish" && e.kind != "refused") continue;
       const json d = json::parse(e.json, nullptr, false);
-      finished_ = {d.is_object() ? d.value("by", std::string("operator")) : "operator", e.at};
+      if (e.kind == "finish") {
+        finished_ = {d.is_object() ? d.value("by", std::string("operator")) : "operator", e.at};
+      } else if (d.is_object() && d.contains("x") && d.contains("y") && d.contains("robot")) {
+        plans_.restore_refusal(
+            d["robot"].get<std::string>(),
+            {{d["x"].get<double>(), d["y"].get<double>()}, d.value("after_scan", std::int64_t{0})});
+      }
     }
   } catch (const std::exception& e) {
-    spdlog::error("could not read whether the mission was finished: {}", e.what());
+    spdlog::error("could not read the mission's log back: {}", e.what());
   }
 }
 
@@ -226,7 +234,14 @@ void Mission::on_status(const std::string& robot, const RobotStatus& status) {
   } else if (status.state == RobotActivity::kRefused) {
     moving_.erase(it);
     plans_.set_candidate_state(candidate, CandidateState::kRefused, status.message);
-    record("refused", {{"candidate", candidate}, {"robot", robot}, {"message", status.message}});
+    json details = {{"candidate", candidate}, {"robot", robot}, {"message", status.message}};
+    // Where, and after which scan: a restart reads the refusal back (restore_refusals).
+    if (const auto found = plans_.find(candidate)) {
+      details["x"] = found->candidate.candidate.position.x();
+      details["y"] = found->candidate.candidate.position.y();
+      details["after_scan"] = plans_.latest_scan();
+    }
+    record("refused", details);
   }
 }
 

@@ -78,7 +78,7 @@ bool PlanBook::set_candidate_state(std::uint64_t id, CandidateState state,
       c.state = state;
       c.note = note;
       if (state == CandidateState::kRefused)
-        refused_[robot].push_back(c.candidate.position.head<2>());
+        refused_[robot].push_back({c.candidate.position.head<2>(), latest_scan_});
       if (state == CandidateState::kReached) {
         reached_[robot] = c.candidate.position;
       } else if (state != CandidateState::kRejected) {
@@ -92,16 +92,32 @@ bool PlanBook::set_candidate_state(std::uint64_t id, CandidateState state,
 
 std::vector<Eigen::Vector2d> PlanBook::refused_points(const std::string& robot) const {
   std::lock_guard lock(mutex_);
-  const auto it = refused_.find(robot);
-  return it == refused_.end() ? std::vector<Eigen::Vector2d>{} : it->second;
+  std::vector<Eigen::Vector2d> points;
+  if (const auto it = refused_.find(robot); it != refused_.end()) {
+    for (const Refusal& r : it->second) points.push_back(r.at);
+  }
+  return points;
 }
 
-void PlanBook::forget_refusals_near(double x, double y, double radius_m) {
+void PlanBook::forget_refusals_near(double x, double y, double radius_m, std::int64_t scan_id) {
   std::lock_guard lock(mutex_);
+  latest_scan_ = std::max(latest_scan_, scan_id);
   const Eigen::Vector2d at(x, y);
-  for (auto& [robot, points] : refused_) {
-    std::erase_if(points, [&](const Eigen::Vector2d& p) { return (p - at).norm() <= radius_m; });
+  for (auto& [robot, refusals] : refused_) {
+    std::erase_if(refusals, [&](const Refusal& r) {
+      return r.after_scan < scan_id && (r.at - at).norm() <= radius_m;
+    });
   }
+}
+
+void PlanBook::restore_refusal(const std::string& robot, const Refusal& refusal) {
+  std::lock_guard lock(mutex_);
+  refused_[robot].push_back(refusal);
+}
+
+std::int64_t PlanBook::latest_scan() const {
+  std::lock_guard lock(mutex_);
+  return latest_scan_;
 }
 
 std::optional<PlanBook::Found> PlanBook::find(std::uint64_t id) const {

@@ -79,16 +79,26 @@ class PlanBook {
   // else the best candidates of their plans.
   std::vector<Eigen::Vector3d> claims_except(const std::string& robot) const;
   // The points `robot` refused to drive to (candidates set kRefused), which its plans leave out
-  // until the map there changes: forget_refusals_near drops those within `radius_m` of a new
-  // scan.
+  // until the map there changes: forget_refusals_near drops those within `radius_m` of scan
+  // `scan_id` when it joined the map after the refusal. Each refusal remembers the newest scan
+  // the map had then (after_scan), so a restarted server that reads the refusals back from the
+  // session (restore_refusal) and then reloads the scans keeps exactly those still standing.
+  struct Refusal {
+    Eigen::Vector2d at;
+    std::int64_t after_scan = 0;
+  };
   std::vector<Eigen::Vector2d> refused_points(const std::string& robot) const;
-  void forget_refusals_near(double x, double y, double radius_m);
+  void forget_refusals_near(double x, double y, double radius_m, std::int64_t scan_id);
+  void restore_refusal(const std::string& robot, const Refusal& refusal);
+  // The newest scan that joined the map (forget_refusals_near): what a refusal now comes after.
+  std::int64_t latest_scan() const;
 
  private:
   mutable std::mutex mutex_;
-  std::map<std::string, PlanRecord> plans_;                      // by robot
-  std::map<std::string, Eigen::Vector3d> reached_;               // by robot: take_reached_goal
-  std::map<std::string, std::vector<Eigen::Vector2d>> refused_;  // by robot
+  std::map<std::string, PlanRecord> plans_;              // by robot
+  std::map<std::string, Eigen::Vector3d> reached_;       // by robot: take_reached_goal
+  std::map<std::string, std::vector<Refusal>> refused_;  // by robot
+  std::int64_t latest_scan_ = 0;
   std::string latest_robot_;
   std::atomic<std::uint64_t> next_plan_id_{1}, next_candidate_id_{1};
 };

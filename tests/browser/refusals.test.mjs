@@ -63,3 +63,23 @@ test('every suggestion refused: the page says so and offers the operator\'s own 
     assert.deepEqual(problems.pageErrors, []);
   });
 });
+
+test('a restarted server still does not suggest the refused points', { timeout: 90000 }, async () => {
+  const log = (await (await stack.api('GET', '/api/v1/decisions')).json()).decisions;
+  const refused = log.filter((d) => d.kind === 'refused');
+  assert.ok(refused.length >= 2, `${refused.length} refusals on record`);
+  for (const d of refused) assert.ok(Number.isFinite(d.x) && Number.isFinite(d.y) && d.after_scan === 1, JSON.stringify(d));
+  const tokens = { operator: stack.token, viewer: stack.viewerToken };
+  const dir = stack.dir;
+  await stack.stop({ keepDir: true, signal: 'SIGKILL' });
+  stack = await startStack({ bridge: false, dir, tokens });
+  const plan = await stack.waitFor('the plan after the restart', async () => {
+    const b = await (await stack.api('GET', '/api/v1/candidates')).json();
+    return b.plan ? b : undefined;
+  });
+  // Nothing within the planner's clearance (5 m) of a refused point: the same points would be
+  // refused again. The scan they came after does not forget them as it reloads.
+  for (const c of plan.candidates) {
+    for (const d of refused) assert.ok(Math.hypot(c.x - d.x, c.y - d.y) >= 5 - 1e-6, `candidate ${c.id} (${c.x}, ${c.y}) near refused (${d.x}, ${d.y})`);
+  }
+});

@@ -96,10 +96,24 @@ TEST(PlanBook, ARefusedPointIsKeptForItsRobotUntilAScanNearItChangesTheMap) {
   EXPECT_TRUE(book.refused_points("b").empty()) << "robot b may still go there";
   // A new plan does not forget it; a scan farther than the radius does not either.
   book.replace({{3, 2, "a", "paper", 0.5, 1, {at(4, 1, 60)}}}, "a");
-  book.forget_refusals_near(40, 0, 20);
+  book.forget_refusals_near(40, 0, 20, 2);
   EXPECT_EQ(book.refused_points("a").size(), 1u);
-  book.forget_refusals_near(25, 0, 20);
+  book.forget_refusals_near(25, 0, 20, 3);
   EXPECT_TRUE(book.refused_points("a").empty());
+}
+
+// A restarted server reads the refusals back before it reloads the scans: the scans up to the
+// one a refusal came after do not forget it, a later scan near it does.
+TEST(PlanBook, ARestoredRefusalOutlivesTheScansBeforeIt) {
+  PlanBook book;
+  book.restore_refusal("a", {{10, 0}, 4});
+  book.restore_refusal("a", {{200, 0}, 4});
+  for (std::int64_t id = 1; id <= 4; ++id) book.forget_refusals_near(12, 0, 20, id);
+  EXPECT_EQ(book.refused_points("a").size(), 2u);
+  book.forget_refusals_near(12, 0, 20, 5);
+  ASSERT_EQ(book.refused_points("a").size(), 1u);
+  EXPECT_EQ(book.refused_points("a")[0], Eigen::Vector2d(200, 0));
+  EXPECT_EQ(book.latest_scan(), 5);
 }
 
 TEST(PlanBook, IdsAreUniqueAcrossPlans) {
