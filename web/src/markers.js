@@ -78,7 +78,18 @@ export class Markers {
     };
     this.materials = new Map(); // colour -> material
     this.lineMaterials = [];
+    this.shown = {}; // group name -> what it was last built from (see _same)
     view.afterRender = () => this.declutter();
+  }
+
+  // Whether group `name` already shows `data`: robot poses and paths are set again on every
+  // status and poll, and each rebuild re-draws the whole point cloud, a large part of a second
+  // on a laptop without a GPU. Nothing changed, nothing is drawn.
+  _same(name, data) {
+    const key = JSON.stringify(data);
+    if (this.shown[name] === key) return true;
+    this.shown[name] = key;
+    return false;
   }
 
   /** Hides each label that overlaps a more important one on screen (see PRIORITY). */
@@ -125,6 +136,7 @@ export class Markers {
 
   /** @param {Array<{id: number, placed: {x: number, y: number, z: number}}>} scans */
   setScans(scans) {
+    if (this._same('scans', scans.map((s) => [s.id, s.placed.x, s.placed.y, s.placed.z]))) return;
     this._clear('scans');
     for (const s of scans) {
       const [r, g, b] = scanColor(s.id);
@@ -141,6 +153,8 @@ export class Markers {
 
   /** Candidates of the current plans; `selected` is a candidate id or null. */
   setCandidates(list, selected) {
+    const colors = list.map((c) => robotColor(c.robot));
+    if (this._same('candidates', [list.map((c) => [c.id, c.state, c.rank, c.x, c.y, c.z, c.gain_unscanned_m2, c.gain_low_res_m2]), selected, colors])) return;
     this._clear('candidates');
     // With several robots each label says whose plan it is from.
     const several = new Set(list.map((c) => c.robot)).size > 1;
@@ -169,6 +183,7 @@ export class Markers {
    * @param {Array<{path: Array<[number, number]>, z0: number, z1: number}>} drives
    */
   setPaths(drives) {
+    if (this._same('path', drives)) return;
     this._clear('path');
     if (!this.lineMaterials.length) {
       this.lineMaterials.push(new LineBasicMaterial({ color: STATE_COLORS.moving, depthTest: false, transparent: true }));
@@ -183,6 +198,7 @@ export class Markers {
 
   /** @param {Array<{id: string, pose: {x: number, y: number, z: number, yaw_deg: number}}>} robots */
   setRobots(robots) {
+    if (this._same('robot', robots.map(({ id, pose }) => [id, robotColor(id), pose]))) return;
     this._clear('robot');
     for (const { id, pose } of robots) {
       if (!pose || !Number.isFinite(pose.x)) continue;
@@ -203,6 +219,7 @@ export class Markers {
 
   /** @param {Array<{id, kind, x, y, z, text}>} list */
   setAnnotations(list) {
+    if (this._same('annotations', list.map((a) => [a.id, a.kind, a.x, a.y, a.z, a.text]))) return;
     this._clear('annotations');
     for (const a of list) {
       const color = ANNOTATION_COLORS[a.kind] ?? ANNOTATION_COLORS.note;
@@ -219,6 +236,7 @@ export class Markers {
 
   dispose() {
     if (this.view.afterRender) this.view.afterRender = null;
+    this.shown = {};
     for (const name of Object.keys(this.groups)) this._clear(name);
     this.view.overlay.remove(this.root);
     for (const g of Object.values(this.geo)) g.dispose();
