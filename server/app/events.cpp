@@ -14,7 +14,8 @@ namespace scanplan::server {
 void Events::publish(const std::string& type, nlohmann::json data) const {
   if (!hub_) return;
   data["type"] = type;
-  data["at"] = iso8601_utc_now();
+  // Milliseconds: events of one scan come within a second, and latencies are read from them.
+  data["at"] = iso8601_utc_now(TimePrecision::kMilliseconds);
   try {
     hub_->broadcast_text(data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   } catch (const std::exception& e) {

@@ -172,7 +172,9 @@ StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
 
 void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud, bool restoring) {
   LiveMap::Added added = live_.add(scan, cloud);
-  std::vector<PlanRecord>& plans = added.plans;
+  // What the operator waits for goes out first: the new candidates (a few kilobytes), then the
+  // scan's chunk for the 3-D view (its Draco encoding and a megabyte on the link).
+  publish_plans(std::move(added.plans), scan.robot);
   // A scan waiting outside the map is not shown: it may be metres off.
   if (added.in_map) {
     if (const auto chunk = live_.encoded_chunk(scan.id)) events_.map_chunk(scan.id, *chunk);
@@ -182,7 +184,6 @@ void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud, bool r
   // Brought back after a restart, the graph retraces the corrections already recorded: the
   // session gets one revision once all scans are back (resume_poses).
   if (!restoring) record_correction(added.corrected);
-  publish_plans(std::move(plans), scan.robot);
 }
 
 void ScanIntake::publish_plans(std::vector<PlanRecord> plans, const std::string& first) {

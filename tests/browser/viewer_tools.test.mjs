@@ -146,16 +146,30 @@ test('measure tool, level of detail and colour modes', { timeout: 60000 }, async
     // Level of detail: a budget below the points held draws a share of every chunk (the full
     // budget once the camera is at rest: the clicks above count as touching it).
     await page.waitForFunction(() => !window.scanplan.view.interacting);
+    // The budget alone first (the drawing speed measured on this machine set aside), then a
+    // renderer as slow as 250 points a millisecond: a frame at rest is capped to 400 ms of it.
     const lod = await page.evaluate(async () => {
       const { view } = window.scanplan;
+      const speed = view.pointsPerMs;
+      view.pointsPerMs = null;
       view.setBudget(50000);
       await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
       const small = { held: view.pointCount, drawn: view.drawnCount };
+      view.pointsPerMs = null;
       view.setBudget(4000000);
-      return { small, full: view.drawnCount };
+      const full = view.drawnCount;
+      view.pointsPerMs = 250;
+      view._applyLod();
+      const capped = view.drawnCount;
+      view.pointsPerMs = speed;
+      view._applyLod();
+      return { small, full, capped, speed };
     });
+    t.diagnostic(`drawing speed here: ${Math.round(lod.speed ?? 0)} points/ms`);
     assert.ok(lod.small.drawn <= 50000 + 10 && lod.small.drawn >= 49000, `budget 50 k drew ${lod.small.drawn}`);
     assert.equal(lod.full, lod.small.held, 'the whole map again with a larger budget');
+    assert.ok(lod.small.held > 100000, `${lod.small.held} points held`);
+    assert.ok(lod.capped >= 100000 && lod.capped <= 100010, `a slow renderer drew ${lod.capped} at rest`);
 
     // Colour modes: height and scan colours look different from the camera's.
     const look = async () => {

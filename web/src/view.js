@@ -5,6 +5,13 @@
 // points (a draw range: nothing is re-uploaded); while the camera moves the fraction drops further
 // so orbiting stays fluid, and the full budget comes back when it stops.
 //
+// The budget also follows the measured drawing speed (points per millisecond, from the time until
+// the next animation frame after a drawn one): a laptop without a working GPU driver draws a
+// million points in about 0.6 s on Chromium's software renderer, so there a frame is capped to
+// what it draws in 100 ms while the camera moves (10 frames a second) and in 400 ms at rest —
+// the page, the candidates the operator waits for included, never freezes for seconds behind one
+// frame. With a GPU the cap lies far above the budget and changes nothing.
+//
 // Colour modes (one shader, chosen by a uniform): the camera's colours, height (turbo ramp over
 // the map's height range) or one colour per scan.
 import {
@@ -29,6 +36,10 @@ import { CSS2DRenderer } from 'three/addons/renderers/CSS2DRenderer.js';
 export const BACKGROUND = 0x15181d;
 export const COLOR_MODES = { rgb: 0, height: 1, scan: 2 };
 const INTERACTIVE_SHARE = 0.35; // of the budget, while the camera moves
+const MOVING_FRAME_MS = 100; // the longest frame while the camera moves: 10 frames a second
+const REST_FRAME_MS = 400; // the longest frame at rest
+const MIN_CAPPED_POINTS = 100_000; // a cap never thins the map below this
+const VSYNC_MS = 34; // a frame back within two display refreshes did not limit the drawing
 const NO_COLOUR = [0.72, 0.77, 0.82];
 
 const VERTEX = /* glsl */ `
@@ -136,6 +147,9 @@ export class MapView {
     this.framed = false;
     this.dirty = true;
     this.drawn = 0;
+    this.pointsPerMs = null; // measured drawing speed; null until a frame has been timed
+    this._timing = null; // {t0, drawn} of the frame drawn last, until the next animation frame
+    this._fraction = 1; // the fraction of every chunk drawn now (_applyLod)
     this.onClick = null; // (event, pick) for tools
     this.afterRender = null; // called after each drawn frame (the markers declutter their labels)
     this.onLodChange = null;
@@ -287,12 +301,31 @@ export class MapView {
   get lodFraction() {
     const total = this.pointCount;
     if (!total) return 1;
-    const budget = this.interacting ? this.budget * INTERACTIVE_SHARE : this.budget;
+    let budget = this.interacting ? this.budget * INTERACTIVE_SHARE : this.budget;
+    if (this.pointsPerMs) {
+      const frameMs = this.interacting ? MOVING_FRAME_MS : REST_FRAME_MS;
+      budget = Math.min(budget, Math.max(MIN_CAPPED_POINTS, this.pointsPerMs * frameMs));
+    }
     return Math.min(1, budget / total);
+  }
+
+  /** The drawing speed from the frame just drawn; re-applies the LOD when it moved the cap. */
+  _timeFrame(now) {
+    const t = this._timing;
+    this._timing = null;
+    if (!t || t.drawn < MIN_CAPPED_POINTS) return;
+    const ms = now - t.t0;
+    // Back within two refreshes: the drawing did not limit the frame, the speed is at least this.
+    const rate = t.drawn / Math.max(ms, VSYNC_MS);
+    if (ms <= VSYNC_MS) this.pointsPerMs = Math.max(this.pointsPerMs ?? 0, rate);
+    else this.pointsPerMs = this.pointsPerMs ? 0.6 * this.pointsPerMs + 0.4 * rate : rate;
+    const f = this.lodFraction;
+    if (Math.abs(f - this._fraction) > 0.15 * this._fraction) this._applyLod();
   }
 
   _applyLod() {
     const f = this.lodFraction;
+    this._fraction = f;
     let drawn = 0;
     for (const c of this.chunks.values()) {
       const n = f >= 1 ? c.count : Math.max(1, Math.ceil(c.count * f));
@@ -406,12 +439,15 @@ export class MapView {
   }
 
   _frame() {
+    const now = performance.now();
+    this._timeFrame(now);
     const moving = this.controls.update();
     if (moving || this.dirty) {
       this.dirty = false;
       this.renderer.render(this.scene, this.camera);
       this.labels.render(this.scene, this.camera);
       this.afterRender?.();
+      this._timing = { t0: now, drawn: this.drawn };
     }
   }
 
