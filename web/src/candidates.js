@@ -50,6 +50,19 @@ export function newGround(c) {
   return (c.gain_unscanned_m2 || 0) + (c.gain_low_res_m2 || 0);
 }
 
+const POLICY_TEXT = {
+  paper: 'hill climbing (paper)',
+  exhaustive: 'best point (exhaustive)',
+  travel: 'best point for the drive',
+  'nearest-frontier': 'nearest frontier',
+  random: 'random',
+};
+
+/** How a plan was made, in words: the search, and what coarse ground counts for (α, Eq. 1). */
+function howPlanned(p) {
+  return `${POLICY_TEXT[p.policy] ?? p.policy}, coarse ground counts ×${p.alpha}`;
+}
+
 export class CandidatesPanel {
   /**
    * @param {{list: HTMLElement, detail: HTMLElement, summary: HTMLElement}} els
@@ -137,11 +150,11 @@ export class CandidatesPanel {
     const { list, detail, summary } = this.els;
     if (this.several) {
       const p = this.plan;
-      summary.textContent = `${this.plans.length} robots, one plan each, no two sent to one spot · ${p.policy}, α ${p.alpha} · ` +
+      summary.textContent = `${this.plans.length} robots, one plan each, no two sent to one spot · ${howPlanned(p)} · ` +
         this.plans.map((q) => `${q.robot}: plan ${q.id}`).join(', ');
     } else if (this.plan) {
       const p = this.plan;
-      summary.textContent = `plan ${p.id} after scan ${p.based_on_scan} · ${p.policy}, α ${p.alpha} · ${nf0.format(p.plan_ms)} ms`;
+      summary.textContent = `plan ${p.id} after scan ${p.based_on_scan} · ${howPlanned(p)} · ${nf0.format(p.plan_ms)} ms`;
     } else {
       summary.textContent = 'no plan yet: the planner runs after each scan';
     }
@@ -196,7 +209,8 @@ export class CandidatesPanel {
       fact('never scanned', `${nf0.format(c.gain_unscanned_m2)} m²`);
       fact('now coarse', `${nf0.format(c.gain_low_res_m2)} m²`);
       fact('position', `${nf1.format(c.x)}, ${nf1.format(c.y)}, ${nf1.format(c.z)} m`);
-      fact('F (Eq. 1)', nf1.format(c.f));
+      // The planner's score (paper Eq. 1): never-scanned ground plus α times the coarse ground.
+      fact('score F', `${nf0.format(c.f)} m²`);
       if (c.overlap_m2 > 0) fact('overlap', `${nf0.format(c.overlap_m2)} m² of the map in view`);
       const forecast = matchForecast(c);
       if (forecast) fact('matching', forecast);

@@ -36,7 +36,7 @@ function paramsChanged(e) {
   const p = e.params ?? {};
   const zones = p.no_go?.length ?? 0;
   const area = p.target ? `area of ${p.target.length} corners` : 'default area';
-  return `${e.by ?? 'operator'} set the mission's parameters: ${area}, ${zones} no-go zone${zones === 1 ? '' : 's'}, α ${p.alpha}`;
+  return `${e.by ?? 'operator'} set the mission's parameters: ${area}, ${zones} no-go zone${zones === 1 ? '' : 's'}, coarse ground counts ×${p.alpha}`;
 }
 
 function describe(e) {
