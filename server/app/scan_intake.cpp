@@ -179,11 +179,12 @@ void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud, bool r
   if (added.in_map) {
     if (const auto chunk = live_.encoded_chunk(scan.id)) events_.map_chunk(scan.id, *chunk);
   }
-  const MapAreas a = live_.areas();
-  events_.publish("map_updated", map_updated_json(scan, a, added.in_map));
   // Brought back after a restart, the graph retraces the corrections already recorded: the
   // session gets one revision once all scans are back (resume_poses).
   if (!restoring) record_correction(added.corrected);
+  // The scan's last word: a client that saw it has every event of the scan.
+  const MapAreas a = live_.areas();
+  events_.publish("map_updated", map_updated_json(scan, a, added.in_map));
 }
 
 void ScanIntake::publish_plans(std::vector<PlanRecord> plans, const std::string& first) {

@@ -5,21 +5,12 @@
 // Screenshots: $SCREENSHOT_DIR/area_1024x768.png, tablet_768x1024.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { execFileSync } from 'node:child_process';
-import { mkdtempSync, writeFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join } from 'node:path';
-import { scanAndWait, startStack, requireEnv } from '../support/stack.mjs';
+import { startOneScanReplay } from '../support/stack.mjs';
 import { frames, openPage, overflowing, screenshot, waitForData, withBrowser } from '../support/browser.mjs';
 
 let stack;
 before(async () => {
-  const dir = mkdtempSync(join(tmpdir(), 'scanplan-area-'));
-  execFileSync(requireEnv('SCANPLAN_CLI'), ['scan', '--world', join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples/worlds/yard.json'),
-    '--at', '-15,-8,0,0', '--out', join(dir, 'scan0.ply'), '--seed', '1'], { stdio: 'ignore' });
-  writeFileSync(join(dir, 'poses.csv'), 'file,x,y,z,yaw_deg\nscan0.ply,-15,-8,0,0\n');
-  stack = await startStack({ replay: dir });
-  await scanAndWait(stack, 1);
+  stack = await startOneScanReplay();
 });
 after(async () => stack && (await stack.stop()));
 

@@ -29,13 +29,13 @@ test('the page draws the map as the graph has it and says when it was corrected'
     await new Promise((resolve, reject) => { ws.on('open', resolve); ws.on('error', reject); });
     const corrections = [];
     let lastScan = 0;
-    let settled = false; // the plans after the last scan: every event of that scan came before
+    let settled = false; // the last scan's map_updated, its last event: every other came before
     ws.on('message', (data, isBinary) => {
       if (isBinary) return;
       const e = JSON.parse(data.toString());
       if (e.type === 'map_corrected') corrections.push(e);
       if (e.type === 'map_updated') lastScan = e.scan;
-      if (e.type === 'plan_done' && lastScan === uploads.length) settled = true;
+      if (e.type === 'map_updated' && lastScan === uploads.length) settled = true;
     });
     for (const u of uploads) {
       const r = await stack.api('POST', u.path, { body: u.body });

@@ -84,7 +84,7 @@ test('operator page: map, candidates, approval, growth by WebSocket chunk, recon
     assert.match(detail, /now coarse\s+[\d,]+ m²/);
     assert.match(detail, /drive\s+[\d.]+ m/);
     assert.match(detail, /position\s+-?[\d.]+, -?[\d.]+, -?[\d.]+ m/);
-    assert.match(detail, /F \(Eq\. 1\)/);
+    assert.match(detail, /score F\s+[\d,]+ m²/);
     assert.match(await page.locator('#cand-list .cand-row').first().innerText(), /≈ [\d,]+ m²\s+new ground · F [\d,]+\s+[\d.]+ m/);
     // The planner's forecast of matching a scan there (matching is on).
     assert.match(detail, /overlap\s+[\d,]+ m² of the map in view/);

@@ -3,21 +3,12 @@
 // robot's reason, and once none is left the page says so and points to the operator's own point.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { execFileSync } from 'node:child_process';
-import { mkdtempSync, writeFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join } from 'node:path';
-import { scanAndWait, startStack, requireEnv } from '../support/stack.mjs';
+import { startOneScanReplay, startStack } from '../support/stack.mjs';
 import { openPage, screenshot, waitForData, withBrowser } from '../support/browser.mjs';
 
 let stack;
 before(async () => {
-  const dir = mkdtempSync(join(tmpdir(), 'scanplan-refusals-'));
-  execFileSync(requireEnv('SCANPLAN_CLI'), ['scan', '--world', join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples/worlds/yard.json'),
-    '--at', '-15,-8,0,0', '--out', join(dir, 'scan0.ply'), '--seed', '1'], { stdio: 'ignore' });
-  writeFileSync(join(dir, 'poses.csv'), 'file,x,y,z,yaw_deg\nscan0.ply,-15,-8,0,0\n');
-  stack = await startStack({ replay: dir });
-  await scanAndWait(stack, 1);
+  stack = await startOneScanReplay();
 });
 after(async () => stack && (await stack.stop()));
 

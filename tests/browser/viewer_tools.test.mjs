@@ -38,7 +38,7 @@ test('a viewer sees the map and the plan but no action buttons', { timeout: 6000
 
     // The candidates and their details are there, the decisions are not.
     await page.locator('#cand-list .cand-row').first().click();
-    assert.match(await page.locator('#cand-detail').innerText(), /F \(Eq\. 1\)/);
+    assert.match(await page.locator('#cand-detail').innerText(), /score F\s+[\d,]+ m²/);
     assert.equal(await page.locator('#approve').count(), 0, 'no approve button');
     assert.equal(await page.locator('#reject').count(), 0, 'no reject button');
     assert.equal(await page.locator('#cand-detail .actions').count(), 0);

@@ -1,6 +1,6 @@
 // Starts a real scanplan-bridge + scanplan-server pair for a process-level test: DDS on
 // loopback in the test's own domain, HTTP on an ephemeral port, a session in a temp directory.
-import { spawn } from 'node:child_process';
+import { execFileSync, spawn } from 'node:child_process';
 import { mkdtempSync, readFileSync, writeFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
@@ -145,6 +145,18 @@ export async function scanAndWait(stack, count) {
     const s = await (await stack.api('GET', '/api/v1/session')).json();
     return s.scans >= count ? s : undefined;
   });
+}
+
+// A stack whose bridge replays one recorded yard scan taken at (−15, −8) (such a bridge cannot
+// drive: it refuses every move), with that scan in the session and its plan made.
+export async function startOneScanReplay() {
+  const dir = mkdtempSync(join(tmpdir(), 'scanplan-replay-'));
+  execFileSync(requireEnv('SCANPLAN_CLI'), ['scan', '--world', join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples/worlds/yard.json'),
+    '--at', '-15,-8,0,0', '--out', join(dir, 'scan0.ply'), '--seed', '1'], { stdio: 'ignore' });
+  writeFileSync(join(dir, 'poses.csv'), 'file,x,y,z,yaw_deg\nscan0.ply,-15,-8,0,0\n');
+  const stack = await startStack({ replay: dir });
+  await scanAndWait(stack, 1);
+  return stack;
 }
 
 // Runs `scanplan args…` against `stack` (its URL, the given token: the operator's by default)
