@@ -84,7 +84,12 @@ try {
       const shown = await page.evaluate(() => Object.values(window.__latency.shown).flat().length);
       return shown >= scans ? true : undefined;
     }, 180000);
-    return page.evaluate(() => window.__latency);
+    // At rest the view fills in the rest of the budget, pass by pass.
+    const rest0 = Date.now();
+    await page.waitForFunction(() => !window.scanplan.view.fill && !window.scanplan.view.dirty, null, { timeout: 60000, polling: 50 });
+    const atRest = await page.evaluate(() => ({ held: window.scanplan.view.pointCount, drawn: window.scanplan.view.drawnCount, budget: window.scanplan.view.budget, points_per_ms: Math.round(window.scanplan.view.pointsPerMs ?? 0) }));
+    atRest.fill_ms = Date.now() - rest0;
+    return { ...(await page.evaluate(() => window.__latency)), atRest };
   });
 
   // Pair each scan end with the first plan of that robot after it, and that plan's frame.
@@ -109,6 +114,7 @@ try {
     server_ms_max: Math.max(...server),
     page_minus_server_ms_median: median(page) - median(server),
     page_ms: page.map(Math.round),
+    at_rest: result.atRest,
   }));
 } finally {
   await stack.stop();

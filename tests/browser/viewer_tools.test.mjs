@@ -161,15 +161,25 @@ test('measure tool, level of detail and colour modes', { timeout: 60000 }, async
       view.pointsPerMs = 250;
       view._applyLod();
       const capped = view.drawnCount;
+      // At rest the fill draws the rest of the budget over that frame, 150 ms of drawing a pass.
+      view.fill = { done: view._fraction, next: 0 };
+      const passes = [];
+      while (view.fill && passes.length < 20) {
+        view._fillPass(performance.now());
+        passes.push(view.drawnCount);
+      }
       view.pointsPerMs = speed;
       view._applyLod();
-      return { small, full, capped, speed };
+      return { small, full, capped, passes, speed };
     });
     t.diagnostic(`drawing speed here: ${Math.round(lod.speed ?? 0)} points/ms`);
     assert.ok(lod.small.drawn <= 50000 + 10 && lod.small.drawn >= 49000, `budget 50 k drew ${lod.small.drawn}`);
     assert.equal(lod.full, lod.small.held, 'the whole map again with a larger budget');
     assert.ok(lod.small.held > 100000, `${lod.small.held} points held`);
     assert.ok(lod.capped >= 100000 && lod.capped <= 100010, `a slow renderer drew ${lod.capped} at rest`);
+    // 250 points/ms × 150 ms = 37,500 points a pass, until every point held is drawn.
+    assert.equal(lod.passes.at(-1), lod.small.held, `the fill drew ${lod.passes}`);
+    assert.ok(Math.abs(lod.passes.length - Math.ceil((lod.small.held - 100000) / 37500)) <= 1, `passes ${lod.passes}`);
 
     // Colour modes: height and scan colours look different from the camera's.
     const look = async () => {

@@ -10,7 +10,11 @@
 // million points in about 0.6 s on Chromium's software renderer, so there a frame is capped to
 // what it draws in 100 ms while the camera moves (10 frames a second) and in 400 ms at rest —
 // the page, the candidates the operator waits for included, never freezes for seconds behind one
-// frame. With a GPU the cap lies far above the budget and changes nothing.
+// frame. At rest the rest of the budget then fills in over the frame already drawn, a slice of
+// every chunk per pass (about 150 ms of drawing each, a pause as long after it, starting a second
+// after the view came to rest; the drawing buffer is kept), so the full detail comes back while
+// the page stays responsive and the server keeps its share of the CPU. With a GPU the cap lies far above
+// the budget and changes nothing.
 //
 // Colour modes (one shader, chosen by a uniform): the camera's colours, height (turbo ramp over
 // the map's height range) or one colour per scan.
@@ -40,6 +44,10 @@ const MOVING_FRAME_MS = 100; // the longest frame while the camera moves: 10 fra
 const REST_FRAME_MS = 400; // the longest frame at rest
 const MIN_CAPPED_POINTS = 100_000; // a cap never thins the map below this
 const VSYNC_MS = 34; // a frame back within two display refreshes did not limit the drawing
+const FILL_FRAME_MS = 150; // one pass of the fill at rest
+// The fill starts after this long at rest and rests as long as each pass took: on a software
+// renderer drawing is CPU time, and the server on the same laptop needs it for the next scan.
+const FILL_DELAY_MS = 1000;
 const NO_COLOUR = [0.72, 0.77, 0.82];
 
 const VERTEX = /* glsl */ `
@@ -149,7 +157,9 @@ export class MapView {
     this.drawn = 0;
     this.pointsPerMs = null; // measured drawing speed; null until a frame has been timed
     this._timing = null; // {t0, drawn} of the frame drawn last, until the next animation frame
-    this._fraction = 1; // the fraction of every chunk drawn now (_applyLod)
+    this._fraction = 1; // the fraction of every chunk a frame draws (_applyLod)
+    this.fill = null; // {done}: at rest, the fraction drawn so far by the fill passes
+    this._extended = false; // the draw ranges reach past _fraction (what the fill drew)
     this.onClick = null; // (event, pick) for tools
     this.afterRender = null; // called after each drawn frame (the markers declutter their labels)
     this.onLodChange = null;
@@ -309,34 +319,69 @@ export class MapView {
     return Math.min(1, budget / total);
   }
 
+  /** The share of every chunk the budget alone allows at rest: what the fill completes. */
+  get budgetFraction() {
+    const total = this.pointCount;
+    return total ? Math.min(1, this.budget / total) : 1;
+  }
+
   /** The drawing speed from the frame just drawn; re-applies the LOD when it moved the cap. */
   _timeFrame(now) {
     const t = this._timing;
     this._timing = null;
-    if (!t || t.drawn < MIN_CAPPED_POINTS) return;
+    if (!t || t.drawn < (t.fill ? 1 : MIN_CAPPED_POINTS)) return;
     const ms = now - t.t0;
     // Back within two refreshes: the drawing did not limit the frame, the speed is at least this.
     const rate = t.drawn / Math.max(ms, VSYNC_MS);
     if (ms <= VSYNC_MS) this.pointsPerMs = Math.max(this.pointsPerMs ?? 0, rate);
     else this.pointsPerMs = this.pointsPerMs ? 0.6 * this.pointsPerMs + 0.4 * rate : rate;
+    if (t.fill) return; // a fill pass sizes the next pass, it does not restart the drawing
     const f = this.lodFraction;
     if (Math.abs(f - this._fraction) > 0.15 * this._fraction) this._applyLod();
   }
 
   _applyLod() {
-    const f = this.lodFraction;
-    this._fraction = f;
+    this._fraction = this.lodFraction;
+    this._setRanges(this._fraction);
+    this.requestRender();
+  }
+
+  /** Every chunk drawn from its first point up to `f` of it. */
+  _setRanges(f) {
     let drawn = 0;
     for (const c of this.chunks.values()) {
       const n = f >= 1 ? c.count : Math.max(1, Math.ceil(c.count * f));
       c.points.geometry.setDrawRange(0, n);
       drawn += n;
     }
+    this._extended = f > this._fraction;
     if (drawn !== this.drawn) {
       this.drawn = drawn;
       this.onLodChange?.();
     }
-    this.requestRender();
+  }
+
+  /** One pass of the fill at rest: the next slice of every chunk, drawn over what is there. */
+  _fillPass(now) {
+    const total = this.pointCount;
+    const target = this.budgetFraction;
+    const from = this.fill.done;
+    const step = ((this.pointsPerMs ?? 0) * FILL_FRAME_MS) / Math.max(1, total);
+    const to = Math.min(target, from + Math.max(step, 0.01));
+    let slice = 0;
+    for (const c of this.chunks.values()) {
+      const a = Math.ceil(c.count * from);
+      const b = to >= 1 ? c.count : Math.ceil(c.count * to);
+      c.points.geometry.setDrawRange(a, Math.max(0, b - a));
+      slice += Math.max(0, b - a);
+    }
+    this.renderer.autoClear = false;
+    this.renderer.render(this.scene, this.camera);
+    this.renderer.autoClear = true;
+    this._timing = { t0: now, drawn: slice, fill: true };
+    // What is on screen now, for picking and the counts.
+    this._setRanges(to);
+    this.fill = to >= target ? null : { done: to, next: now + FILL_FRAME_MS };
   }
 
   /** Puts the whole map in view, looking from the south-west and above. */
@@ -444,10 +489,15 @@ export class MapView {
     const moving = this.controls.update();
     if (moving || this.dirty) {
       this.dirty = false;
+      // A new frame starts from the capped share; what a fill drew is drawn again by a new fill.
+      if (this._extended) this._setRanges(this._fraction);
       this.renderer.render(this.scene, this.camera);
       this.labels.render(this.scene, this.camera);
       this.afterRender?.();
       this._timing = { t0: now, drawn: this.drawn };
+      this.fill = !moving && !this.interacting && this._fraction < this.budgetFraction ? { done: this._fraction, next: now + FILL_DELAY_MS } : null;
+    } else if (this.fill && now >= this.fill.next) {
+      this._fillPass(now);
     }
   }
 
