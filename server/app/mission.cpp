@@ -25,7 +25,10 @@ Mission::Mission(LiveMap& map, PlanBook& plans, const RobotBoard& robots, RobotL
       const json d = json::parse(e.json, nullptr, false);
       if (e.kind == "finish") {
         finished_ = {d.is_object() ? d.value("by", std::string("operator")) : "operator", e.at};
-      } else if (d.is_object() && d.contains("x") && d.contains("y") && d.contains("robot")) {
+      } else if (d.is_object() && d.value("x", json()).is_number() &&
+                 d.value("y", json()).is_number() && d.value("robot", json()).is_string() &&
+                 d.value("after_scan", json(0)).is_number_integer()) {
+        // Only a refusal with its place and scan: an older row, or a damaged one, is passed over.
         plans_.restore_refusal(
             d["robot"].get<std::string>(),
             {{d["x"].get<double>(), d["y"].get<double>()}, d.value("after_scan", std::int64_t{0})});

@@ -173,7 +173,7 @@ StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
 void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud, bool restoring) {
   LiveMap::Added added = live_.add(scan, cloud);
   // What the operator waits for goes out first: the new candidates (a few kilobytes), then the
-  // scan's chunk for the 3-D view (its Draco encoding and a megabyte on the link).
+  // scan's chunk for the 3-D view (a megabyte on the link, perhaps encoded now).
   publish_plans(std::move(added.plans), scan.robot);
   // A scan waiting outside the map is not shown: it may be metres off.
   if (added.in_map) {

@@ -135,6 +135,20 @@ TEST_F(MissionTest, ARefusedMoveKeepsTheRobotsReason) {
   EXPECT_NO_THROW(mission_->approve(12, "operator"));
 }
 
+// A refusal is recorded with where it was and after which scan; a mission made on that session
+// (a restarted server) reads it back, and passes over a row without a usable place.
+TEST_F(MissionTest, ARefusalIsReadBackAfterARestart) {
+  const Approval a = mission_->approve(11, "operator");
+  mission_->on_status("a", status(a.command_id, RobotActivity::kRefused, "a wall in the way"));
+  session_->append_event("refused", R"({"candidate":12,"robot":"a","x":"east","y":1})");
+  session_->append_event("refused", "not json");
+  PlanBook restarted;
+  const Mission again(*map_, restarted, board_, robots_, *session_, events_);
+  ASSERT_EQ(restarted.refused_points("a").size(), 1u);
+  EXPECT_EQ(restarted.refused_points("a")[0], Eigen::Vector2d(10, 0));
+  EXPECT_TRUE(restarted.refused_points("b").empty());
+}
+
 TEST_F(MissionTest, OneMoveAtATimePerRobotAndDecidedCandidatesAreClosed) {
   mission_->approve(11, "operator");
   EXPECT_EQ(errc_of([&] { mission_->approve(11, "operator"); }), MissionErrc::kConflict);
