@@ -5,7 +5,10 @@
 // baseline: the candidates exist on the server), `page` = the animation frame in which the page's
 // candidate list first shows the plan made after that scan (and the scan is drawn). The top
 // candidate is approved over REST each time (not clicked: the click's own delay is not the path).
-// Prints one JSON line. Usage: tests/bench/scan_to_page.sh [SCANS] [ROBOTS]
+// Stage by stage (medians, from the server's event times and the page's clock): the scan's way in
+// (done → scan_received: DDS transfer, the PLY synced), matching (→ match_done), the map, regions,
+// layers and plan (→ plan_done), the page (→ candidates shown), and the scan's chunk drawn in the
+// 3-D view (plan_done → drawn). Prints one JSON line. Usage: tests/bench/scan_to_page.sh [SCANS] [ROBOTS]
 import { mkdtempSync, readFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
@@ -32,7 +35,7 @@ try {
     await page.waitForFunction(() => document.body.dataset.ws === 'open', null, { timeout: 30000 });
     // In the page: the server times of each scan's end and plan, and the frame that shows it.
     await page.evaluate(() => {
-      const log = { done: {}, plan: {}, shown: {} }; // by robot: [{at, ...}]
+      const log = { done: {}, plan: {}, shown: {}, received: {}, matched: {}, drawn: {} }; // by robot, or by scan
       window.__latency = log;
       const push = (k, robot, v) => (log[k][robot] ??= []).push(v);
       const { events, candidates } = window.scanplan;
@@ -40,7 +43,15 @@ try {
       events.onEvent = (e) => {
         if (e.type === 'scan_progress' && e.state === 'done') push('done', e.robot, Date.parse(e.at));
         if (e.type === 'plan_done') push('plan', e.robot, { at: Date.parse(e.at), scan: e.based_on_scan });
+        if (e.type === 'scan_received') push('received', e.robot, { at: Date.parse(e.at), scan: e.scan });
+        if (e.type === 'match_done') log.matched[e.scan] = Date.parse(e.at);
         inner(e);
+      };
+      const { view } = window.scanplan;
+      const addChunk = view.addChunk.bind(view);
+      view.addChunk = (c) => {
+        log.drawn[c.id] ??= Date.now();
+        return addChunk(c);
       };
       const seen = new Set();
       const frame = () => {
@@ -95,6 +106,7 @@ try {
   // Pair each scan end with the first plan of that robot after it, and that plan's frame.
   const page = [];
   const server = [];
+  const stages = { way_in: [], matching: [], map_and_plan: [], page: [], chunk_drawn_after_plan: [] };
   for (const [robot, ends] of Object.entries(result.done)) {
     for (const done of ends) {
       const plan = (result.plan[robot] || []).find((p) => p.at >= done);
@@ -102,6 +114,13 @@ try {
       const shown = (result.shown[robot] || []).find((s) => s.scan === plan.scan);
       server.push(plan.at - done);
       if (shown) page.push(shown.at - done);
+      const received = (result.received[robot] || []).find((r) => r.scan === plan.scan);
+      const matched = result.matched[plan.scan];
+      if (received) stages.way_in.push(received.at - done);
+      if (received && matched) stages.matching.push(matched - received.at);
+      if (matched) stages.map_and_plan.push(plan.at - matched);
+      if (shown) stages.page.push(shown.at - plan.at);
+      if (result.drawn[plan.scan]) stages.chunk_drawn_after_plan.push(result.drawn[plan.scan] - plan.at);
     }
   }
   console.log(JSON.stringify({
@@ -113,6 +132,7 @@ try {
     server_ms_median: median(server),
     server_ms_max: Math.max(...server),
     page_minus_server_ms_median: median(page) - median(server),
+    stage_ms_median: Object.fromEntries(Object.entries(stages).map(([k, v]) => [k, median(v)])),
     page_ms: page.map(Math.round),
     at_rest: result.atRest,
   }));
