@@ -7,8 +7,8 @@
 // candidate is approved over REST each time (not clicked: the click's own delay is not the path).
 // Stage by stage (medians, from the server's event times and the page's clock): the scan's way in
 // (done → scan_received: DDS transfer, the PLY synced), matching (→ match_done), the map, regions,
-// layers and plan (→ plan_done), the page (→ candidates shown), and the scan's chunk drawn in the
-// 3-D view (plan_done → drawn). Prints one JSON line. Usage: tests/bench/scan_to_page.sh [SCANS] [ROBOTS]
+// layers and plan (→ plan_done; of which the planner's own plan_ms), the page (→ candidates
+// shown), and the scan's chunk drawn in the 3-D view (plan_done → drawn). Prints one JSON line. Usage: tests/bench/scan_to_page.sh [SCANS] [ROBOTS]
 import { mkdtempSync, readFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
@@ -42,7 +42,7 @@ try {
       const inner = events.onEvent;
       events.onEvent = (e) => {
         if (e.type === 'scan_progress' && e.state === 'done') push('done', e.robot, Date.parse(e.at));
-        if (e.type === 'plan_done') push('plan', e.robot, { at: Date.parse(e.at), scan: e.based_on_scan });
+        if (e.type === 'plan_done') push('plan', e.robot, { at: Date.parse(e.at), scan: e.based_on_scan, ms: e.plan_ms });
         if (e.type === 'scan_received') push('received', e.robot, { at: Date.parse(e.at), scan: e.scan });
         if (e.type === 'match_done') log.matched[e.scan] = Date.parse(e.at);
         inner(e);
@@ -106,7 +106,7 @@ try {
   // Pair each scan end with the first plan of that robot after it, and that plan's frame.
   const page = [];
   const server = [];
-  const stages = { way_in: [], matching: [], map_and_plan: [], page: [], chunk_drawn_after_plan: [] };
+  const stages = { way_in: [], matching: [], map_and_plan: [], of_which_planner: [], page: [], chunk_drawn_after_plan: [] };
   for (const [robot, ends] of Object.entries(result.done)) {
     for (const done of ends) {
       const plan = (result.plan[robot] || []).find((p) => p.at >= done);
@@ -119,6 +119,7 @@ try {
       if (received) stages.way_in.push(received.at - done);
       if (received && matched) stages.matching.push(matched - received.at);
       if (matched) stages.map_and_plan.push(plan.at - matched);
+      if (Number.isFinite(plan.ms)) stages.of_which_planner.push(plan.ms);
       if (shown) stages.page.push(shown.at - plan.at);
       if (result.drawn[plan.scan]) stages.chunk_drawn_after_plan.push(result.drawn[plan.scan] - plan.at);
     }
