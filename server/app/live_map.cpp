@@ -57,7 +57,9 @@ LiveMap::~LiveMap() {
 void LiveMap::encode_loop() {
   std::unique_lock lock(mutex_);
   for (;;) {
-    encode_wanted_.wait(lock, [&] { return stopping_ || encoded_generation_ != generation_; });
+    encode_wanted_.wait(lock, [&] {
+      return stopping_ || (encoded_generation_ != generation_ && encode_waiters_ > 0);
+    });
     if (stopping_) return;
     std::vector<std::shared_ptr<const PointCloud>> parts;
     for (std::size_t i = 0; i < placed_.size(); ++i) {
@@ -616,8 +618,11 @@ LiveMap::Rebuilt LiveMap::rebuild(const std::vector<StoredScan>& keep, const Sca
 LiveMap::EncodedMap LiveMap::encoded_map(std::chrono::milliseconds wait) const {
   std::unique_lock lock(mutex_);
   if (scans_.empty()) return {};
+  ++encode_waiters_;
+  encode_wanted_.notify_one();
   encoded_changed_.wait_for(lock, wait,
                             [&] { return stopping_ || encoded_generation_ == generation_; });
+  --encode_waiters_;
   return {encoded_, encoded_last_scan_};
 }
 

@@ -202,11 +202,14 @@ class LiveMap {
   std::shared_ptr<const std::string> encoded_;  // the whole map up to encoded_last_scan_
   std::int64_t encoded_last_scan_ = 0;
   // Counts every change of the map's scans (a scan joined, the map rebuilt); the encoder
-  // catches up with it, and encoded_map() waits for it.
+  // catches up with it while someone waits in encoded_map() (encode_waiters_), not after every
+  // scan: the whole map is seconds of CPU at millions of points, which the next scan's match and
+  // plan need on a 2-core laptop, and clients fetch scans one by one (?since, ?until).
   std::uint64_t generation_ = 0;
   std::uint64_t encoded_generation_ = 0;
+  mutable int encode_waiters_ = 0;                   // with mutex_
   mutable std::condition_variable encoded_changed_;  // with mutex_
-  std::condition_variable encode_wanted_;            // with mutex_
+  mutable std::condition_variable encode_wanted_;    // with mutex_
   bool stopping_ = false;
   VoxelMap thinned_{kThinnedMapVoxelM};  // under encode_mutex_
   // By scan id; null until made (encoded_chunk) after the scan moved.

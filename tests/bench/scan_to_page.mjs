@@ -103,6 +103,10 @@ try {
     return { ...(await page.evaluate(() => window.__latency)), atRest };
   });
 
+  // The server's CPU time over the whole run (user + system, /proc/PID/stat fields 14 and 15).
+  const stat = readFileSync(`/proc/${stack.server.pid}/stat`, 'utf8');
+  const fields = stat.slice(stat.lastIndexOf(')') + 2).split(' ');
+  const serverCpuS = (Number(fields[11]) + Number(fields[12])) / 100;
   // Pair each scan end with the first plan of that robot after it, and that plan's frame.
   const page = [];
   const server = [];
@@ -133,6 +137,7 @@ try {
     server_ms_median: median(server),
     server_ms_max: Math.max(...server),
     page_minus_server_ms_median: median(page) - median(server),
+    server_cpu_s: serverCpuS,
     stage_ms_median: Object.fromEntries(Object.entries(stages).map(([k, v]) => [k, median(v)])),
     page_ms: page.map(Math.round),
     at_rest: result.atRest,
