@@ -11,8 +11,8 @@
 // what it draws in 100 ms while the camera moves (10 frames a second) and in 400 ms at rest —
 // the page, the candidates the operator waits for included, never freezes for seconds behind one
 // frame. At rest the rest of the budget then fills in over the frame already drawn, a slice of
-// every chunk per pass (about 150 ms of drawing each, a pause as long after it, starting a second
-// after the view came to rest; the drawing buffer is kept), so the full detail comes back while
+// every chunk per pass (about 150 ms of drawing each, a pause twice as long after it, starting two
+// seconds after the view came to rest; the drawing buffer is kept), so the full detail comes back while
 // the page stays responsive and the server keeps its share of the CPU. With a GPU the cap lies far above
 // the budget and changes nothing.
 //
@@ -45,9 +45,11 @@ const REST_FRAME_MS = 400; // the longest frame at rest
 const MIN_CAPPED_POINTS = 100_000; // a cap never thins the map below this
 const VSYNC_MS = 34; // a frame back within two display refreshes did not limit the drawing
 const FILL_FRAME_MS = 150; // one pass of the fill at rest
-// The fill starts after this long at rest and rests as long as each pass took: on a software
-// renderer drawing is CPU time, and the server on the same laptop needs it for the next scan.
-const FILL_DELAY_MS = 1000;
+// The fill starts after this long at rest and then rests twice as long as each pass took: on a
+// software renderer drawing is CPU time, and the server on the same laptop needs it for the next
+// scan (a scan comes a minute or more after the last; the fill is done long before).
+const FILL_DELAY_MS = 2000;
+const FILL_PAUSE = 2; // × the pass's drawing time
 const NO_COLOUR = [0.72, 0.77, 0.82];
 
 const VERTEX = /* glsl */ `
@@ -381,7 +383,7 @@ export class MapView {
     this._timing = { t0: now, drawn: slice, fill: true };
     // What is on screen now, for picking and the counts.
     this._setRanges(to);
-    this.fill = to >= target ? null : { done: to, next: now + FILL_FRAME_MS };
+    this.fill = to >= target ? null : { done: to, next: now + FILL_PAUSE * FILL_FRAME_MS };
   }
 
   /** Puts the whole map in view, looking from the south-west and above. */
