@@ -484,11 +484,29 @@ PredictionCheck check_prediction(const MlsMap& map, const RegionMap& regions, co
   return out;
 }
 
+bool same_ranked(const Plan& a, const Plan& b) {
+  if (a.ranked.size() != b.ranked.size()) return false;
+  for (std::size_t k = 0; k < a.ranked.size(); ++k) {
+    if (a.ranked[k].position != b.ranked[k].position || a.ranked[k].f != b.ranked[k].f ||
+        a.ranked[k].score != b.ranked[k].score)
+      return false;
+  }
+  return true;
+}
+
+double share(std::size_t part, std::size_t whole) {
+  return whole > 0 ? static_cast<double>(part) / static_cast<double>(whole) : 0.0;
+}
+
 // A closed loop from the five-scan map: each step plans with both `paper` (a new seed each
 // step) and `exhaustive`, then scans at the exhaustive choice; the prediction for that scan is
-// compared with the cells the scan then adds to the map.
+// compared with the cells the scan then adds to the map. Both policies plan a second time with
+// a memo kept over the loop (GainMemo, issue 19): the same plans, and what reuse saves.
 nlohmann::json loop_study(Campus& campus, const PlannerConfig& base, int loop_steps) {
   std::vector<double> gaps, gaps_plain, iou_new, iou_all, gain_ratio, ms_paper, ms_exhaustive;
+  std::vector<double> ms_paper_memo, ms_exhaustive_memo, reused_paper, reused_exhaustive;
+  GainMemo paper_memo, exhaustive_memo;
+  bool memo_plans_same = true;
   double sum_f_paper = 0, sum_f_best = 0;
   for (int step = 0; step < loop_steps; ++step) {
     const PlanInput in = campus.input();
@@ -505,6 +523,18 @@ nlohmann::json loop_study(Campus& campus, const PlannerConfig& base, int loop_st
     if (best.ranked.empty()) break;
     ms_paper.push_back(paper.plan_ms);
     ms_exhaustive.push_back(best.plan_ms);
+    PlanInput with_memo = in;
+    with_memo.memo = &exhaustive_memo;
+    const Plan best_memo = plan_next_scan(with_memo, cfg);
+    cfg.policy = PlannerPolicy::kPaper;
+    with_memo.memo = &paper_memo;
+    const Plan paper_memo_plan = plan_next_scan(with_memo, cfg);
+    memo_plans_same =
+        memo_plans_same && same_ranked(best, best_memo) && same_ranked(paper, paper_memo_plan);
+    ms_exhaustive_memo.push_back(best_memo.plan_ms);
+    ms_paper_memo.push_back(paper_memo_plan.plan_ms);
+    reused_exhaustive.push_back(share(best_memo.reused, best_memo.evaluations));
+    reused_paper.push_back(share(paper_memo_plan.reused, paper_memo_plan.evaluations));
     const double f_best = best.ranked.front().f;
     const double f_paper = paper.ranked.empty() ? 0.0 : paper.ranked.front().f;
     const double f_random = random_starts.ranked.empty() ? 0.0 : random_starts.ranked.front().f;
@@ -533,6 +563,11 @@ nlohmann::json loop_study(Campus& campus, const PlannerConfig& base, int loop_st
           {"paper_f_share_of_optimum", sum_f_best > 0 ? sum_f_paper / sum_f_best : 1.0},
           {"loop_ms_paper_mean", mean_of(ms_paper)},
           {"loop_ms_exhaustive_mean", mean_of(ms_exhaustive)},
+          {"loop_memo_plans_identical", memo_plans_same},
+          {"loop_ms_paper_memo_mean", mean_of(ms_paper_memo)},
+          {"loop_ms_exhaustive_memo_mean", mean_of(ms_exhaustive_memo)},
+          {"loop_memo_reused_share_paper_mean", mean_of(reused_paper)},
+          {"loop_memo_reused_share_exhaustive_mean", mean_of(reused_exhaustive)},
           {"prediction_iou_new_cells_mean", mean_of(iou_new)},
           {"prediction_iou_all_cells_mean", mean_of(iou_all)},
           {"actual_over_predicted_unscanned_gain_mean", mean_of(gain_ratio)}};

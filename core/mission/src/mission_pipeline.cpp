@@ -322,7 +322,10 @@ std::vector<FleetPlan> MissionPipeline::plan(const std::vector<FleetRobot>& robo
   if (!has_map()) return {};
   for (const Eigen::Vector3d& p : unplaced_scan_points()) claimed.push_back(p);
   std::vector<FleetRobot> drifting = robots;
-  for (FleetRobot& r : drifting) r.drift = drift_of(r.id);
+  for (FleetRobot& r : drifting) {
+    r.drift = drift_of(r.id);
+    r.memo = memos_->of(r.id);
+  }
   return plan_fleet(mapping_.map(), *mapping_.target(), mapping_.scan_points(), drifting,
                     std::move(claimed), config_.planner, anchored_map());
 }
@@ -372,7 +375,15 @@ Plan MissionPipeline::plan_from(const Eigen::Vector3d& robot, std::uint64_t seed
   if (!unplaced.empty()) in.claimed = &unplaced;
   const std::optional<DriveDrift> drift = drift_of(track);
   if (drift) in.drift = &*drift;
+  in.memo = memos_->of(track);
   return plan_next_scan(in, planner);
+}
+
+GainMemo* MissionPipeline::Memos::of(const std::string& robot) {
+  std::lock_guard lock(mutex);
+  auto& memo = by_robot[robot];
+  if (!memo) memo = std::make_unique<GainMemo>();
+  return memo.get();
 }
 
 void MissionPipeline::set_planner(const PlannerConfig& planner) {

@@ -16,7 +16,7 @@ std::vector<FleetPlan> plan_fleet(const MlsMap& map, const TargetRegion& target,
   }
   std::vector<FleetPlan> decided;
   std::vector<FleetRobot> open = robots;
-  while (!open.empty()) {
+  for (bool first_turn = true; !open.empty(); first_turn = false) {
     std::vector<Plan> plans;
     plans.reserve(open.size());
     for (const FleetRobot& r : open) {
@@ -31,6 +31,7 @@ std::vector<FleetPlan> plan_fleet(const MlsMap& map, const TargetRegion& target,
       in.anchored = anchored;
       in.drift = r.drift ? &*r.drift : nullptr;
       in.refused = &r.refused;
+      if (first_turn) in.memo = r.memo;
       plans.push_back(plan_next_scan(in, cfg));
     }
     // The highest best score; then, among those close to it, the shortest drive.

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "digest.hpp"
 #include "scanplan/geometry/pose.hpp"
 
 namespace scanplan {
@@ -91,6 +92,23 @@ void RegistrabilityField::Forecast::add(std::uint32_t o, int di, int dj) {
   ptp_ += w * (qx * tqx + qy * tqy);
   r2_ += w * r2;
   walls_ += w;
+}
+
+std::uint64_t RegistrabilityField::digest() const {
+  using digest::mix;
+  const RegistrabilityConfig& c = config_;
+  std::uint64_t h = mix(std::uint64_t{0xF1E1D}, static_cast<std::uint64_t>(c.enabled));
+  for (const double v :
+       {c.min_overlap_share, c.min_pose_fixing, c.floor_share, c.near_range_m, cell_m_})
+    h = mix(h, v);
+  return h;
+}
+
+std::uint64_t RegistrabilityField::cell_digest(std::size_t offset) const {
+  using digest::mix;
+  const Cell& c = cells_[offset];
+  const std::uint64_t flags = c.mapped | (std::uint64_t{c.wall} << 8);
+  return mix(mix(mix(mix(std::uint64_t{0xCE11}, flags), c.t_xx), c.t_xy), c.t_yy);
 }
 
 Registrability RegistrabilityField::Forecast::result() const {

@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "digest.hpp"
+
 namespace scanplan {
 
 ScanGainEvaluator::ScanGainEvaluator(const MlsMap& map, const RegionMap& regions, double alpha,
@@ -59,6 +61,24 @@ ScanGain ScanGainEvaluator::at(CellIndex b, double floor_z,
   g.f = alpha_ * g.unscanned_m2 + (1 - alpha_) * g.low_resolution_m2;
   if (forecast) g.registrability = forecast->result();
   return g;
+}
+
+std::uint64_t ScanGainEvaluator::digest() const {
+  using digest::mix;
+  std::uint64_t h = mix(mix(predictor_.digest(), alpha_), completed_radius_cells2_);
+  return registrability_ ? mix(h, registrability_->digest()) : h;
+}
+
+std::uint64_t ScanGainEvaluator::cell_digest(std::size_t dense_offset) const {
+  using digest::mix;
+  const auto cols = static_cast<std::size_t>(predictor_.dense_cols());
+  const CellIndex c{predictor_.dense_origin().x + static_cast<std::int32_t>(dense_offset % cols),
+                    predictor_.dense_origin().y + static_cast<std::int32_t>(dense_offset / cols)};
+  std::uint64_t h = predictor_.cell_digest(dense_offset);
+  const auto o = regions_.cells.offset(c);
+  if (!o) return mix(h, std::uint64_t{0xFF});  // outside the raster: never counted
+  h = mix(h, static_cast<std::uint64_t>(regions_.cells.values[*o]));
+  return registrability_ ? mix(h, registrability_->cell_digest(*o)) : h;
 }
 
 ScanGain ScanGainEvaluator::at(CellIndex b, double floor_z) const {

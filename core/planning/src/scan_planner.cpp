@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <mutex>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -209,18 +210,77 @@ using Scorer = std::function<double(std::int32_t site, const ScanGain& gain)>;
 // A policy's score once the best F of a first look over the region is known.
 using ScorerFor = std::function<Scorer(double best_f)>;
 
-// F at a site, its forecast with the drive there.
-ScanGain site_gain(const ScanGainEvaluator& gain, const Sites& sites, std::int32_t site,
-                   VisibilityPredictor::Workspace& ws) {
-  const auto u = static_cast<std::size_t>(site);
-  ScanGain g = gain.at(sites.cell[u], sites.floor_z[u], ws);
-  if (g.registrability && !sites.reach.empty()) {
-    Registrability& r = *g.registrability;
-    r.reach = sites.reach[u];
-    if (r.reach < 1) r.factor = std::max(sites.floor_share, r.factor * r.reach * r.reach);
+// F at the sites, through the plan's memo when it has one: an evaluation still valid is taken
+// from it, one made afresh is queued per thread and kept once the parallel part is over. With
+// drifting odometry each site's forecast then takes the drive there.
+class SiteGains {
+ public:
+  SiteGains(const ScanGainEvaluator& gain, const Sites& sites, GainMemo* memo, int threads)
+      : gain_(gain),
+        sites_(sites),
+        memo_(memo),
+        fresh_(static_cast<std::size_t>(threads)),
+        reused_(static_cast<std::size_t>(threads), 0) {}
+
+  VisibilityPredictor::Workspace workspace() const { return gain_.workspace(); }
+
+  ScanGain at(std::int32_t site, VisibilityPredictor::Workspace& ws) {
+    const auto u = static_cast<std::size_t>(site);
+    const CellIndex cell = sites_.cell[u];
+    const float floor_z = sites_.floor_z[u];
+    const std::size_t thread = thread_index();
+    std::optional<ScanGain> found;
+    if (memo_) found = memo_->find(gain_, cell, floor_z);
+    ScanGain g;
+    if (found) {
+      g = std::move(*found);
+      ++reused_[thread];
+    } else {
+      g = gain_.at(cell, floor_z, ws);
+      if (memo_) fresh_[thread].push_back({cell, floor_z, g, ws.walks()});
+    }
+    if (g.registrability && !sites_.reach.empty()) {
+      Registrability& r = *g.registrability;
+      r.reach = sites_.reach[u];
+      if (r.reach < 1) r.factor = std::max(sites_.floor_share, r.factor * r.reach * r.reach);
+    }
+    return g;
   }
-  return g;
-}
+
+  // Keeps the fresh evaluations; returns how many were reused. Outside parallel parts only.
+  std::size_t keep_fresh() {
+    std::size_t reused = 0;
+    for (const std::size_t r : reused_) reused += r;
+    if (!memo_) return reused;
+    for (auto& list : fresh_) {
+      for (Fresh& f : list) memo_->keep(f.cell, f.floor_z, f.gain, std::move(f.walks));
+      list.clear();
+    }
+    memo_->finish(reused);
+    return reused;
+  }
+
+ private:
+  struct Fresh {
+    CellIndex cell;
+    float floor_z;
+    ScanGain gain;
+    std::vector<std::uint8_t> walks;
+  };
+  std::size_t thread_index() const {
+#ifdef _OPENMP
+    return std::min(static_cast<std::size_t>(omp_get_thread_num()), fresh_.size() - 1);
+#else
+    return 0;
+#endif
+  }
+
+  const ScanGainEvaluator& gain_;
+  const Sites& sites_;
+  GainMemo* memo_;
+  std::vector<std::vector<Fresh>> fresh_;
+  std::vector<std::size_t> reused_;
+};
 
 // With drifting odometry, each site's drive_reach.
 void forecast_drives(Sites& sites, const DriveDrift* drift, const RegistrabilityConfig& cfg) {
@@ -238,9 +298,8 @@ Scorer gain_only(double) {
 }
 
 // F at the given sites, shared over the threads; the order of `which` is kept.
-std::vector<Scored> evaluate_sites(const ScanGainEvaluator& gain, const Sites& sites,
-                                   const std::vector<std::int32_t>& which, int threads,
-                                   const Scorer& score = by_gain) {
+std::vector<Scored> evaluate_sites(SiteGains& gain, const std::vector<std::int32_t>& which,
+                                   int threads, const Scorer& score = by_gain) {
   std::vector<Scored> out(which.size());
 #pragma omp parallel num_threads(threads)
   {
@@ -248,7 +307,7 @@ std::vector<Scored> evaluate_sites(const ScanGainEvaluator& gain, const Sites& s
 #pragma omp for schedule(dynamic, 4)
     for (std::size_t k = 0; k < which.size(); ++k) {
       out[k].site = which[k];
-      out[k].gain = site_gain(gain, sites, which[k], ws);
+      out[k].gain = gain.at(which[k], ws);
       out[k].score = score(which[k], out[k].gain);
     }
   }
@@ -310,9 +369,8 @@ struct ClimbStarts {
 // a lattice at a random offset, about hill_climb_samples cells on the movable region: random
 // like the paper's starts, but spread evenly, so no part of the region is left without a start
 // nearby.
-ClimbStarts screened_starts(const ScanGainEvaluator& gain, const Sites& sites,
-                            const PlannerConfig& cfg, int threads, const ScorerFor& scorer_for,
-                            SplitMix& rng) {
+ClimbStarts screened_starts(SiteGains& gain, const Sites& sites, const PlannerConfig& cfg,
+                            int threads, const ScorerFor& scorer_for, SplitMix& rng) {
   ClimbStarts out;
   const int stride = std::max(1, static_cast<int>(std::lround(std::sqrt(
                                      static_cast<double>(sites.size()) / cfg.hill_climb_samples))));
@@ -327,7 +385,7 @@ ClimbStarts screened_starts(const ScanGainEvaluator& gain, const Sites& sites,
   }
   // A region thinner than the lattice still gets a start.
   if (sample.empty()) sample.push_back(static_cast<std::int32_t>(rng.below(sites.size())));
-  out.screened = evaluate_sites(gain, sites, sample, threads);
+  out.screened = evaluate_sites(gain, sample, threads);
   double best_f = 0;
   for (const Scored& x : out.screened) best_f = std::max(best_f, x.gain.f);
   out.score = scorer_for(best_f);
@@ -343,17 +401,15 @@ ClimbStarts screened_starts(const ScanGainEvaluator& gain, const Sites& sites,
 }
 
 // The paper's own starts: random cells of the movable region, with no first look.
-ClimbStarts random_starts(const ScanGainEvaluator& gain, const Sites& sites,
-                          const PlannerConfig& cfg, const ScorerFor& scorer_for, SplitMix& rng) {
+ClimbStarts random_starts(SiteGains& gain, const Sites& sites, const PlannerConfig& cfg,
+                          const ScorerFor& scorer_for, SplitMix& rng) {
   ClimbStarts out;
   for (int k = 0; k < cfg.hill_climb_starts; ++k)
     out.sites.push_back(static_cast<std::int32_t>(rng.below(sites.size())));
   // The best F is that of the starts.
   double best_f = 0;
-  for (const std::int32_t s : out.sites) {
-    const auto u = static_cast<std::size_t>(s);
-    best_f = std::max(best_f, gain.at(sites.cell[u], sites.floor_z[u]).f);
-  }
+  auto ws = gain.workspace();
+  for (const std::int32_t s : out.sites) best_f = std::max(best_f, gain.at(s, ws).f);
   out.evaluations = out.sites.size();
   out.score = scorer_for(best_f);
   return out;
@@ -361,9 +417,8 @@ ClimbStarts random_starts(const ScanGainEvaluator& gain, const Sites& sites,
 
 // One climb from `start`: to the best 8-neighbour at the current move length while the score
 // improves, then at half the move. Returns every site it evaluated, in order.
-std::vector<Scored> climb(const ScanGainEvaluator& gain, const Sites& sites, std::int32_t start,
-                          int first_stride, const Scorer& score,
-                          VisibilityPredictor::Workspace& ws) {
+std::vector<Scored> climb(SiteGains& gain, const Sites& sites, std::int32_t start, int first_stride,
+                          const Scorer& score, VisibilityPredictor::Workspace& ws) {
   static constexpr int kDx[8] = {1, 1, 0, -1, -1, -1, 0, 1};
   static constexpr int kDy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
   std::unordered_map<std::int32_t, double> memo;
@@ -371,7 +426,7 @@ std::vector<Scored> climb(const ScanGainEvaluator& gain, const Sites& sites, std
   const auto value_at = [&](std::int32_t s) {
     const auto it = memo.find(s);
     if (it != memo.end()) return it->second;
-    const ScanGain g = site_gain(gain, sites, s, ws);
+    const ScanGain g = gain.at(s, ws);
     const double v = score(s, g);
     memo.emplace(s, v);
     seen.push_back({s, g, v});
@@ -404,9 +459,9 @@ std::vector<Scored> climb(const ScanGainEvaluator& gain, const Sites& sites, std
 // Paper §3.4: hill climbing on F (or another score) from several random starts. Climbs run in
 // parallel, each with its own memory of evaluated cells, so the result and the count of
 // evaluations are the same whatever the thread count.
-std::vector<Scored> hill_climb(const ScanGainEvaluator& gain, const Sites& sites,
-                               const PlannerConfig& cfg, double cell_m, int threads,
-                               const ScorerFor& scorer_for, std::size_t& evaluations) {
+std::vector<Scored> hill_climb(SiteGains& gain, const Sites& sites, const PlannerConfig& cfg,
+                               double cell_m, int threads, const ScorerFor& scorer_for,
+                               std::size_t& evaluations) {
   SplitMix rng(cfg.seed);
   const ClimbStarts starts = cfg.hill_climb_samples > 0
                                  ? screened_starts(gain, sites, cfg, threads, scorer_for, rng)
@@ -458,7 +513,7 @@ std::vector<std::int32_t> frontier_sites(const Sites& sites, const RegionMap& re
 
 // Evaluates `order` batch by batch and keeps the first max_candidates worth scanning (and
 // apart from each other), in that order: the baselines' choice is their order, not F.
-std::vector<Scored> first_worth_scanning(const ScanGainEvaluator& gain, const Sites& sites,
+std::vector<Scored> first_worth_scanning(SiteGains& gain, const Sites& sites,
                                          const std::vector<std::int32_t>& order,
                                          const PlannerConfig& cfg, double cell_m, int threads,
                                          std::size_t& evaluations) {
@@ -472,7 +527,7 @@ std::vector<Scored> first_worth_scanning(const ScanGainEvaluator& gain, const Si
         order.begin() + static_cast<std::ptrdiff_t>(begin),
         order.begin() + static_cast<std::ptrdiff_t>(std::min(order.size(), begin + batch)));
     evaluations += part.size();
-    for (const Scored& s : evaluate_sites(gain, sites, part, threads)) {
+    for (const Scored& s : evaluate_sites(gain, part, threads)) {
       if (static_cast<int>(out.size()) == cfg.max_candidates) break;
       if (s.gain.f < cfg.min_gain_m2) continue;
       const CellIndex c = sites.cell[static_cast<std::size_t>(s.site)];
@@ -520,8 +575,8 @@ std::optional<Eigen::Vector3d> nearest_floor(const MlsMap& map, const Eigen::Vec
 }
 
 // The policy's choice among the sites, best first (PlannerConfig::policy).
-std::vector<Scored> choose(const PlannerConfig& cfg, const ScanGainEvaluator& gain,
-                           const Sites& sites, const RegionMap& regions, double cell_m, int threads,
+std::vector<Scored> choose(const PlannerConfig& cfg, SiteGains& gain, const Sites& sites,
+                           const RegionMap& regions, double cell_m, int threads,
                            std::size_t& evaluations) {
   std::vector<Scored> chosen;
   switch (cfg.policy) {
@@ -535,7 +590,7 @@ std::vector<Scored> choose(const PlannerConfig& cfg, const ScanGainEvaluator& ga
       const Scorer with_completion = [w](std::int32_t, const ScanGain& g) {
         return registrable_f(g) + w * g.completed_m2;
       };
-      auto all = evaluate_sites(gain, sites, lattice_sites(sites, cfg.lattice_m, cell_m), threads,
+      auto all = evaluate_sites(gain, lattice_sites(sites, cfg.lattice_m, cell_m), threads,
                                 with_completion);
       evaluations = all.size();
       chosen = rank(std::move(all), sites, cfg, cell_m);
@@ -676,8 +731,21 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
                                cfg.regions, cfg.visibility, field ? &*field : nullptr);
   if (!claims.empty())
     claim_predicted_scans(claimed_regions, gain.predictor(), claims, cfg.regions);
+  // The memo, unless another plan holds it (then this one goes without).
+  std::unique_lock<std::mutex> memo_lock;
+  GainMemo* memo = nullptr;
+  if (in.memo) {
+    memo_lock = std::unique_lock<std::mutex>(in.memo->in_use(), std::try_to_lock);
+    if (memo_lock.owns_lock()) {
+      memo = in.memo;
+      memo->begin(gain);
+    }
+  }
+  const int threads = thread_count(cfg);
+  SiteGains gains(gain, sites, memo, threads);
   const std::vector<Scored> chosen =
-      choose(cfg, gain, sites, plan.regions, in.map.cell_m(), thread_count(cfg), plan.evaluations);
+      choose(cfg, gains, sites, plan.regions, in.map.cell_m(), threads, plan.evaluations);
+  plan.reused = gains.keep_fresh();
   plan.ranked = to_candidates(chosen, sites, in.map, travel);
   return finish();
 }

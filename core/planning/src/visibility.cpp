@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "digest.hpp"
 #include "fast_atan.hpp"
 #include "scanplan/geometry/pose.hpp"
 
@@ -108,6 +109,8 @@ VisibilityPredictor::VisibilityPredictor(const MlsMap& map, CellIndex raster_ori
   sensor_offset_ = sensor_offset;
   if (config.thin_object_radius_m > 0) find_thin_objects();
   build_rays(sensor_offset);
+  deltas_.reserve(steps_.size());
+  for (const Step& st : steps_) deltas_.push_back(st.dense_delta);
 }
 
 void VisibilityPredictor::build_dense(const MlsMap& map) {
@@ -510,8 +513,14 @@ struct VisibilityPredictor::Tracer {
 
 void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
                                 Workspace& ws) const {
-  const Ray& ray =
-      rays_[level_offset_[static_cast<std::size_t>(level)] + static_cast<std::size_t>(m)];
+  const std::size_t index =
+      level_offset_[static_cast<std::size_t>(level)] + static_cast<std::size_t>(m);
+  const Ray& ray = rays_[index];
+  // From the sensor: the gap filling marks cells back along the walk before this ray's part.
+  const auto walked = [&](const Step* last) {
+    ws.walked[index] = static_cast<std::uint8_t>(
+        std::min<std::ptrdiff_t>(255, last - (steps_.data() + ray.walk_begin) + 1));
+  };
   Trace t = tr;
   t.dir = ray.dir;
   t.half_spacing = static_cast<float>(0.5 * 2 * M_PI / azimuths_ * (1 << level));
@@ -520,10 +529,12 @@ void VisibilityPredictor::trace(const Trace& tr, int level, int m, RayState& st,
   const Step* end = steps_.data() + ray.walk_end;
   for (const Step* s = steps_.data() + ray.segment_begin; s != end; ++s) {
     if (!walker.step(s)) {
+      walked(s);
       st.done = true;
       return;
     }
   }
+  walked(end - 1);
   if (level == 0) return;
   // Split in two, each at the middle of one half of this ray's sector, both going on with
   // everything this one has seen so far.
@@ -549,6 +560,7 @@ const std::vector<std::uint32_t>& VisibilityPredictor::visible_from(CellIndex se
     ws.epoch = 1;
   }
   ws.visible.clear();
+  ws.walked.assign(rays_.size(), 0);
 
   Trace t;
   t.floor = static_cast<float>(floor_z);
@@ -584,6 +596,58 @@ const std::vector<std::uint32_t>& VisibilityPredictor::visible_from(CellIndex se
     trace(t, levels_, m, st, ws);
   }
   return ws.visible;
+}
+
+using digest::mix;
+
+std::uint64_t VisibilityPredictor::digest() const {
+  const VisibilityConfig& c = config_;
+  std::uint64_t h = 0x5CA9;
+  for (const double v : {c.azimuth_step_deg, c.max_ray_spacing_m, c.max_range_m, c.sensor_height_m,
+                         c.elevation_step_deg, c.vertical_fov_deg, c.min_range_m,
+                         c.ground_max_extent_m, c.ground_max_jump_m, c.thin_object_radius_m,
+                         cell_m_, sensor_offset_.x(), sensor_offset_.y()})
+    h = mix(h, v);
+  h = mix(h, static_cast<std::uint64_t>(c.unknown_as_ground) | (std::uint64_t{fill_} << 1));
+  h = mix(mix(mix(h, fill_max_gap_), fill_max_slope_), max_z_);
+  return mix(mix(h, static_cast<std::uint64_t>(beams_)), static_cast<std::uint64_t>(rays_.size()));
+}
+
+std::uint64_t VisibilityPredictor::cell_digest(std::size_t o) const {
+  const DenseCell& d = dense_[o];
+  std::uint64_t h = mix(std::uint64_t{0xCE11}, static_cast<std::uint64_t>(d.n));
+  if (d.n == 0) return h;
+  h = mix(mix(mix(h, d.lo0), d.hi0), d.top);
+  for (int k = 0; k < 2 * d.n; ++k) h = mix(h, patches_[o][static_cast<std::size_t>(k)]);
+  if (d.thin >= 0) {
+    // Where the object stands in the world, not in this raster.
+    const Eigen::Vector2f c = thin_centres_[static_cast<std::size_t>(d.thin)];
+    h = mix(mix(h, c.x() + static_cast<double>(dense_origin_.x) * cell_m_),
+            c.y() + static_cast<double>(dense_origin_.y) * cell_m_);
+  }
+  return h;
+}
+
+bool VisibilityPredictor::walks_reach(CellIndex sensor, const std::vector<std::uint8_t>& walks,
+                                      const std::vector<std::uint32_t>& stamp,
+                                      std::uint32_t since) const {
+  if (walks.size() != rays_.size() || stamp.size() != dense_.size() || sensor.x < sensor_min_.x ||
+      sensor.y < sensor_min_.y || sensor.x > sensor_max_.x || sensor.y > sensor_max_.y) {
+    return true;
+  }
+  const std::uint32_t* at = stamp.data() +
+                            static_cast<std::size_t>(sensor.y - dense_origin_.y) * dense_cols_ +
+                            static_cast<std::size_t>(sensor.x - dense_origin_.x);
+  for (std::size_t r = 0; r < rays_.size(); ++r) {
+    if (walks[r] == 0) continue;
+    const std::uint32_t begin = rays_[r].walk_begin;
+    const std::uint32_t end =
+        walks[r] == 255 ? rays_[r].walk_end : std::min(rays_[r].walk_end, begin + walks[r]);
+    for (std::uint32_t k = begin; k < end; ++k) {
+      if (at[deltas_[k]] >= since) return true;
+    }
+  }
+  return false;
 }
 
 CellGrid<std::uint8_t> predict_visible(const MlsMap& map, const CellGrid<Region>& raster,

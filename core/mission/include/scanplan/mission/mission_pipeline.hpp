@@ -2,7 +2,9 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <vector>
 
@@ -167,6 +169,13 @@ class MissionPipeline {
   // Per scan: how many anchored scans lay near it when it was last matched to the map; it is
   // tried again when more do.
   std::vector<std::size_t> anchored_near_;
+  // Each robot's planner evaluations, reused from one of its plans to the next (GainMemo).
+  struct Memos {
+    std::mutex mutex;
+    std::map<std::string, std::unique_ptr<GainMemo>> by_robot;
+    GainMemo* of(const std::string& robot);
+  };
+  std::shared_ptr<Memos> memos_ = std::make_shared<Memos>();
 
   // The pose sensors place a scan closely enough by themselves when 3σ of their error is
   // within this: the accuracy the map is built to (issue 17's target).

@@ -15,6 +15,9 @@ struct FleetRobot {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   std::optional<DriveDrift> drift;       // PlanInput::drift
   std::vector<Eigen::Vector2d> refused;  // PlanInput::refused
+  // PlanInput::memo for this robot's plans against the claims as given; the turns after a robot
+  // was decided claim more and plan without it.
+  GainMemo* memo = nullptr;
 };
 
 struct FleetPlan {

@@ -79,6 +79,10 @@ class RegistrabilityField {
   RegistrabilityField(const MlsMap& anchored, CellIndex origin, int cols, int rows,
                       const RegistrabilityConfig& config);
 
+  // What a forecast reads (GainMemo): the configuration, and one raster cell.
+  std::uint64_t digest() const;
+  std::uint64_t cell_digest(std::size_t offset) const;
+
   // Sums what a candidate sees, cell by cell (raster offsets), then forecasts.
   class Forecast {
    public:

@@ -51,6 +51,12 @@ class ScanGainEvaluator {
   ScanGain at(CellIndex b, double floor_z) const;
 
   double alpha() const { return alpha_; }
+  // What an evaluation reads, for reusing one while it still holds (GainMemo): `digest` all but
+  // the cells (α, the completed radius, the predictor's and the forecast's own), `cell_digest`
+  // one cell of the predictor's dense raster with its region and what the anchored map holds
+  // there. An evaluation reads only the cells its rays walked (VisibilityPredictor::walks_reach).
+  std::uint64_t digest() const;
+  std::uint64_t cell_digest(std::size_t dense_offset) const;
   const VisibilityPredictor& predictor() const { return predictor_; }
 
  private:

@@ -10,6 +10,7 @@
 #include "scanplan/mapping/mls_map.hpp"
 #include "scanplan/mapping/movable_region.hpp"
 #include "scanplan/mapping/region_segmentation.hpp"
+#include "scanplan/planning/gain_memo.hpp"
 #include "scanplan/planning/registrability.hpp"
 #include "scanplan/planning/visibility.hpp"
 
@@ -136,13 +137,18 @@ struct PlanInput {
   // candidates are forecast with the drive there (RegistrabilityConfig::reach_xy_m). Null: pose
   // sensors that do not drift.
   const DriveDrift* drift = nullptr;
+  // Evaluations kept from this robot's previous plans, reused where the map they read has not
+  // changed (GainMemo), and this plan's kept for the next. The plan is the same with or without.
+  // Null: every evaluation made afresh.
+  GainMemo* memo = nullptr;
 };
 
 struct Plan {
   std::vector<Candidate> ranked;  // best first
   RegionMap regions;              // the map's C/M/U segmentation (without the claims)
   MovableRegion movable;
-  std::size_t evaluations = 0;  // F computations made
+  std::size_t evaluations = 0;  // F values the policy looked at
+  std::size_t reused = 0;       // of them, taken from PlanInput::memo
   double plan_ms = 0;
 };
 

@@ -69,12 +69,16 @@ class VisibilityPredictor {
   class Workspace {
    public:
     Workspace() = default;
+    // How far the last prediction walked each ray of the tree (steps from the sensor, 0: not
+    // traced, 255: 255 or more), what walks_reach reads back.
+    const std::vector<std::uint8_t>& walks() const { return walked; }
 
    private:
     friend class VisibilityPredictor;
     std::vector<std::uint32_t> stamp;
     std::uint32_t epoch = 0;
     std::vector<std::uint32_t> visible;
+    std::vector<std::uint8_t> walked;
   };
 
   // `sensor_offset` is where in its cell the sensor stands, as fractions of the cell (the
@@ -97,6 +101,20 @@ class VisibilityPredictor {
 
   int beams() const { return beams_; }
   int azimuths() const { return azimuths_; }
+
+  // What a prediction reads, for reusing one while it still holds (GainMemo). A prediction
+  // reads the dense raster's cells along the walks of its rays and nothing else of the map;
+  // `digest` covers the rest it depends on (the configuration, the fan, the ray tree, the
+  // highest surface), `cell_digest` one cell's surfaces as the rays meet them.
+  CellIndex dense_origin() const { return dense_origin_; }
+  int dense_cols() const { return dense_cols_; }
+  int dense_rows() const { return dense_rows_; }
+  std::uint64_t digest() const;
+  std::uint64_t cell_digest(std::size_t dense_offset) const;
+  // Whether a walk of a prediction from `sensor` (its Workspace::walks) went through a cell
+  // whose stamp (row-major over the dense raster) is `since` or later.
+  bool walks_reach(CellIndex sensor, const std::vector<std::uint8_t>& walks,
+                   const std::vector<std::uint32_t>& stamp, std::uint32_t since) const;
 
  private:
   static constexpr int kMaxBeamWords = 32;  // 2048 beams in a fan
@@ -156,6 +174,7 @@ class VisibilityPredictor {
   std::vector<Ray> rays_;
   std::vector<std::uint32_t> level_offset_;  // first ray of each level in rays_
   std::vector<Step> steps_;
+  std::vector<std::int32_t> deltas_;  // steps_[k].dense_delta, compact for walks_reach
 };
 
 // Cells of `raster` (same geometry, 1 = seen) a scan from `sensor_xy`, standing on a floor at
