@@ -30,6 +30,24 @@ World random_site(unsigned seed) {
                      "random_site");
 }
 
+// A random site scanned once from its start.
+struct ScannedOnce {
+  explicit ScannedOnce(unsigned seed)
+      : world(random_site(seed)), caster(world), target(world.target_region()) {
+    map.insert_scan(simulate_scan(caster, world.scanner, world.start, 1), world.start.isometry(),
+                    {0, 0, world.scanner.mount_height_m});
+    points = {{world.start.x, world.start.y}};
+  }
+  PlanInput input() const {
+    return {map, target, points, {world.start.x, world.start.y, world.start.z}};
+  }
+  World world;
+  RayCaster caster;
+  TargetRegion target;
+  MlsMap map;
+  std::vector<Eigen::Vector2d> points;
+};
+
 void expect_same(const Plan& fresh, const Plan& memo, const std::string& where) {
   ASSERT_EQ(fresh.ranked.size(), memo.ranked.size()) << where;
   EXPECT_EQ(fresh.evaluations, memo.evaluations) << where;
@@ -91,17 +109,11 @@ TEST(GainMemo, PlansWithTheMemoAreThePlansMadeAfresh) {
 
 // Nothing changed: the second plan reuses every evaluation; a change of α forgets them all.
 TEST(GainMemo, ReusesEverythingWhenNothingChangedAndForgetsOnAnotherAlpha) {
-  const World world = random_site(5);
-  const RayCaster caster(world);
-  const TargetRegion target = world.target_region();
-  MlsMap map;
-  map.insert_scan(simulate_scan(caster, world.scanner, world.start, 1), world.start.isometry(),
-                  {0, 0, world.scanner.mount_height_m});
-  const std::vector<Eigen::Vector2d> points = {{world.start.x, world.start.y}};
+  const ScannedOnce site(5);
   PlannerConfig cfg;
   cfg.policy = PlannerPolicy::kExhaustive;
   GainMemo memo;
-  PlanInput in{map, target, points, {world.start.x, world.start.y, world.start.z}};
+  PlanInput in = site.input();
   in.memo = &memo;
   const Plan first = plan_next_scan(in, cfg);
   ASSERT_GT(first.evaluations, 100u);
@@ -117,16 +129,10 @@ TEST(GainMemo, ReusesEverythingWhenNothingChangedAndForgetsOnAnotherAlpha) {
 
 // A plan that finds the memo held by another plan goes without it, and is the same plan.
 TEST(GainMemo, APlanWhileAnotherHoldsTheMemoGoesWithout) {
-  const World world = random_site(7);
-  const RayCaster caster(world);
-  const TargetRegion target = world.target_region();
-  MlsMap map;
-  map.insert_scan(simulate_scan(caster, world.scanner, world.start, 1), world.start.isometry(),
-                  {0, 0, world.scanner.mount_height_m});
-  const std::vector<Eigen::Vector2d> points = {{world.start.x, world.start.y}};
+  const ScannedOnce site(7);
   PlannerConfig cfg;
   GainMemo memo;
-  PlanInput in{map, target, points, {world.start.x, world.start.y, world.start.z}};
+  PlanInput in = site.input();
   const Plan fresh = plan_next_scan(in, cfg);
   in.memo = &memo;
   std::lock_guard held(memo.in_use());
