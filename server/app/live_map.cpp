@@ -111,13 +111,12 @@ std::optional<MapMatch> LiveMap::place(const PointCloud& scan, const Pose& repor
 }
 
 LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
-  // The scan in the map frame and its own Draco chunk first: should either fail (out of
-  // memory, a Draco error), nothing of the scan has reached the map yet.
+  // The scan in the map frame first: should it fail (out of memory), nothing of the scan has
+  // reached the map yet. Its Draco chunk (~25 ms for a campus scan) is made when first asked
+  // for (encoded_chunk), after the plan has gone out: the operator waits for the candidates.
   std::shared_ptr<const PointCloud> shared = MissionPipeline::to_map_frame(cloud, scan.placed);
-  std::shared_ptr<const std::string> chunk;
-  if (!shared->empty()) chunk = std::make_shared<const std::string>(encode_draco(*shared));
   // Writers take turns on encode_mutex_; readers only wait for the short commit below, and
-  // they see the scan, its points, its chunk and the plan that includes it appear together.
+  // they see the scan, its points and the plan that includes it appear together.
   std::lock_guard encode_lock(encode_mutex_);
   mission_.add(cloud, placement_of(scan), shared);
   // Only writers change the scans, under encode_mutex_ (held): read without mutex_.
@@ -144,11 +143,7 @@ LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
   Added out;
   out.corrected = f.corrected;
   out.in_map = f.in_map.back() != 0;
-  const bool own_chunk = f.placed.back() == shared;
-  out.plans = refresh_derived([&] {
-    commit(std::move(f));
-    if (own_chunk) chunks_[scan.id] = chunk;
-  });
+  out.plans = refresh_derived([&] { commit(std::move(f)); });
   encode_wanted_.notify_one();
   // Outside mutex_ so readers are not held up, inside encode_mutex_ so maps and plans go out in
   // the order they were made; the map first, as the plan is made from it.
@@ -642,7 +637,8 @@ std::shared_ptr<const std::string> LiveMap::encoded_chunk(std::int64_t id) const
     if (const auto it = chunks_.find(id); it != chunks_.end() && it->second) return it->second;
     points = placed_[*at];
   }
-  // A scan the graph moved: its chunk is made when first asked for, outside the lock.
+  // A new scan, or one the graph moved: its chunk is made when first asked for, outside the
+  // lock.
   if (points->empty()) return nullptr;
   auto chunk = std::make_shared<const std::string>(encode_draco(*points));
   std::lock_guard lock(mutex_);
