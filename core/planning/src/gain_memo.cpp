@@ -7,12 +7,12 @@ namespace scanplan {
 void GainMemo::begin(const ScanGainEvaluator& gain) {
   const VisibilityPredictor& vp = gain.predictor();
   ++generation_;
-  stats_ = Stats{};
+  cleared_ = false;
   const std::uint64_t digest = gain.digest();
   if (digest != digest_ || generation_ == 0) {
     entries_.clear();
     digest_ = digest;
-    stats_.cleared = true;
+    cleared_ = true;
   }
   const CellIndex origin = vp.dense_origin();
   const int cols = vp.dense_cols(), rows = vp.dense_rows();
@@ -29,7 +29,6 @@ void GainMemo::begin(const ScanGainEvaluator& gain) {
       if (cell_digests_[old] == digests[o]) stamps[o] = stamps_[old];
     }
   }
-  for (const std::uint32_t s : stamps) stats_.changed_cells += s == generation_;
   origin_ = origin;
   cols_ = cols;
   rows_ = rows;
@@ -53,11 +52,6 @@ void GainMemo::keep(CellIndex cell, float floor_z, const ScanGain& g,
                     std::vector<std::uint8_t> walks) {
   if (entries_.size() >= max_entries_) entries_.clear();
   entries_[key(cell)] = Entry{floor_z, generation_, g, std::move(walks)};
-  ++stats_.evaluated;
-}
-
-void GainMemo::finish(std::size_t reused) {
-  stats_.reused = reused;
 }
 
 }  // namespace scanplan

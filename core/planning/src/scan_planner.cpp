@@ -256,7 +256,6 @@ class SiteGains {
       for (Fresh& f : list) memo_->keep(f.cell, f.floor_z, f.gain, std::move(f.walks));
       list.clear();
     }
-    memo_->finish(reused);
     return reused;
   }
 

@@ -124,7 +124,7 @@ TEST(GainMemo, ReusesEverythingWhenNothingChangedAndForgetsOnAnotherAlpha) {
   cfg.alpha = 0.8;
   const Plan other = plan_next_scan(in, cfg);
   EXPECT_EQ(other.reused, 0u);
-  EXPECT_TRUE(memo.stats().cleared);
+  EXPECT_TRUE(memo.cleared());
 }
 
 // A plan that finds the memo held by another plan goes without it, and is the same plan.

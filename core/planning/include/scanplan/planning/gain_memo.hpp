@@ -34,13 +34,6 @@ class GainMemo {
   // all and starts again.
   explicit GainMemo(std::size_t max_entries = 65536) : max_entries_(max_entries) {}
 
-  struct Stats {
-    std::size_t reused = 0;         // evaluations of the last plan taken from the memo
-    std::size_t evaluated = 0;      // made afresh (and kept)
-    std::size_t changed_cells = 0;  // cells stamped by the last plan's begin
-    bool cleared = false;           // the last plan forgot everything (digest changed)
-  };
-
   // Starts a plan against `gain`: stamps the cells that changed since the previous plan.
   void begin(const ScanGainEvaluator& gain);
   // The evaluation at `cell`, the floor at `floor_z`, when one still holds. Safe to call from
@@ -48,10 +41,9 @@ class GainMemo {
   std::optional<ScanGain> find(const ScanGainEvaluator& gain, CellIndex cell, float floor_z) const;
   // Keeps a fresh evaluation with the walks of the workspace it was made with.
   void keep(CellIndex cell, float floor_z, const ScanGain& g, std::vector<std::uint8_t> walks);
-  // Ends the plan: records how many were reused.
-  void finish(std::size_t reused);
 
-  const Stats& stats() const { return stats_; }
+  // Whether the latest begin forgot everything (ScanGainEvaluator::digest changed).
+  bool cleared() const { return cleared_; }
   std::size_t size() const { return entries_.size(); }
   std::mutex& in_use() { return in_use_; }
 
@@ -78,7 +70,7 @@ class GainMemo {
   int cols_ = 0, rows_ = 0;
   std::vector<std::uint64_t> cell_digests_;
   std::vector<std::uint32_t> stamps_;
-  Stats stats_;
+  bool cleared_ = false;
 };
 
 }  // namespace scanplan
