@@ -223,14 +223,15 @@ json match_done_json(std::int64_t scan, const Pose& e, const MapMatch& m) {
             {"yaw_deg", rad2deg(std::remainder(p.yaw - e.yaw, 2 * M_PI))}}}};
 }
 
-json map_updated_json(const StoredScan& scan, const MapAreas& a, bool in_map) {
+json map_updated_json(const StoredScan& scan, const MapAreas& a, bool in_map, json stages_ms) {
   return {{"scan", scan.id},
           {"points", scan.points},
           {"in_map", in_map},
           {"completed_m2", a.completed_m2},
           {"low_resolution_m2", a.low_resolution_m2},
           {"unscanned_m2", a.unscanned_m2},
-          {"movable_m2", a.movable_m2}};
+          {"movable_m2", a.movable_m2},
+          {"stages_ms", std::move(stages_ms)}};
 }
 
 json map_corrected_json(const MapCorrected& c, std::int64_t revision) {

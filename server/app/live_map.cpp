@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -20,6 +21,11 @@ namespace {
 struct PoseChange {
   double metres = 0, degrees = 0;
 };
+
+using Clock = std::chrono::steady_clock;
+double ms_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
 
 PoseChange change(const Pose& a, const Pose& b) {
   return {std::hypot(b.x - a.x, b.y - a.y, b.z - a.z),
@@ -118,7 +124,9 @@ LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
   // Writers take turns on encode_mutex_; readers only wait for the short commit below, and
   // they see the scan, its points and the plan that includes it appear together.
   std::lock_guard encode_lock(encode_mutex_);
+  const auto join_start = Clock::now();
   mission_.add(cloud, placement_of(scan), shared);
+  const double join_ms = ms_between(join_start, Clock::now());
   // Only writers change the scans, under encode_mutex_ (held): read without mutex_.
   std::vector<StoredScan> scans = scans_;
   std::vector<std::shared_ptr<const PointCloud>> placed = placed_;
@@ -130,8 +138,13 @@ LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
   // The thinned map is 0.3 m cubes: made anew when scans join or leave the map or move by a
   // third of a cube (a few seconds' work on a large map), else the new scan is added.
   const MapCorrected& c = f.corrected;
+  const auto thin_start = Clock::now();
   rethin(f,
          /*whole=*/!c.joined.empty() || !c.left.empty() || c.max_moved_m > kThinnedMapVoxelM / 3);
+  Added out;
+  out.times.thin = ms_between(thin_start, Clock::now());
+  if (const auto& graph = mission_.last_correction()) out.times.graph = graph->graph_ms;
+  out.times.map = join_ms - out.times.graph;
   follow_robots(f);
   last_scan_ = {scan.id, scan.robot};
   // The map changed around the new scan: points a robot refused there may be worth a try again
@@ -140,10 +153,9 @@ LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
     const Pose& at = f.scans.back().placed;
     plans_.forget_refusals_near(at.x, at.y, mission_.planner().regions.completed_radius_m, scan.id);
   }
-  Added out;
   out.corrected = f.corrected;
   out.in_map = f.in_map.back() != 0;
-  out.plans = refresh_derived([&] { commit(std::move(f)); });
+  out.plans = refresh_derived([&] { commit(std::move(f)); }, /*scan_joined=*/true, &out.times);
   encode_wanted_.notify_one();
   // Outside mutex_ so readers are not held up, inside encode_mutex_ so maps and plans go out in
   // the order they were made; the map first, as the plan is made from it.
@@ -330,14 +342,20 @@ std::map<std::string, std::shared_ptr<const std::vector<std::uint8_t>>> LiveMap:
 }
 
 std::vector<PlanRecord> LiveMap::refresh_derived(const std::function<void()>& commit,
-                                                 bool scan_joined) {
+                                                 bool scan_joined, AddTimes* times) {
   if (!mission_.has_map()) {
     std::lock_guard lock(mutex_);
     if (commit) commit();
     return {};
   }
+  const auto t0 = Clock::now();
   std::vector<PlanRecord> records = make_plans();
+  const auto t1 = Clock::now();
   auto layers = render_layers();
+  if (times) {
+    times->plan = ms_between(t0, t1);
+    times->layers = ms_between(t1, Clock::now());
+  }
   const RegionMap& regions = *mission_.mapping().regions();
   const auto elevation_m = elevation_range(mission_.mapping().map(), regions);
   const MapAreas areas{regions.completed_m2(), regions.low_resolution_m2(), regions.unscanned_m2(),

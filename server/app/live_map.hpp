@@ -113,10 +113,17 @@ class LiveMap {
   // driving to a goal; the scanning robot's last) and what the pose graph changed.
   // With the graph, a scan no believed match ties in waits outside the map (waiting()): its
   // points are in no map encoding, thinned map or bounds until it joins.
+  // Where adding a scan went, wall clock in ms: the pose graph (pairs, refused scans matched
+  // again, the solve), the map following it (MLS map, segmentation, movable region), the
+  // thinned map, the plans, the layers' images.
+  struct AddTimes {
+    double graph = 0, map = 0, thin = 0, plan = 0, layers = 0;
+  };
   struct Added {
     std::vector<PlanRecord> plans;
     MapCorrected corrected;
     bool in_map = true;  // the new scan joined the map (with the graph, it may wait outside)
+    AddTimes times;
   };
   Added add(const StoredScan& scan, const PointCloud& cloud);
 
@@ -264,8 +271,9 @@ class LiveMap {
   // whatever `commit` changes (run under mutex_); needs encode_mutex_ held. Returns the new
   // plans, that of the robot whose scan came last last (none when there is no map to plan on).
   // `scan_joined`: the commit brings a new scan, whose areas after it are kept (areas_after).
+  // `times`: the plans' and layers' time goes there.
   std::vector<PlanRecord> refresh_derived(const std::function<void()>& commit,
-                                          bool scan_joined = true);
+                                          bool scan_joined = true, AddTimes* times = nullptr);
   // One plan per robot not driving to a goal, the driving robots' goals claimed first; that of
   // the robot whose scan came last last. Needs encode_mutex_ held.
   std::vector<PlanRecord> make_plans() const;

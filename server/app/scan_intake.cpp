@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -170,7 +171,8 @@ StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
   return scan;
 }
 
-void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud, bool restoring) {
+void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud, bool restoring,
+                         std::optional<double> match_ms) {
   LiveMap::Added added = live_.add(scan, cloud);
   // What the operator waits for goes out first: the new candidates (a few kilobytes), then the
   // scan's chunk for the 3-D view (a megabyte on the link, perhaps encoded now).
@@ -184,7 +186,12 @@ void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud, bool r
   if (!restoring) record_correction(added.corrected);
   // The scan's last word: a client that saw it has every event of the scan.
   const MapAreas a = live_.areas();
-  events_.publish("map_updated", map_updated_json(scan, a, added.in_map));
+  const LiveMap::AddTimes& t = added.times;
+  nlohmann::json stages = {
+      {"graph", t.graph}, {"map", t.map}, {"thin", t.thin}, {"plan", t.plan}, {"layers", t.layers}};
+  if (match_ms) stages["match"] = *match_ms;
+  spdlog::debug("scan {}: {}", scan.id, stages.dump());
+  events_.publish("map_updated", map_updated_json(scan, a, added.in_map, std::move(stages)));
 }
 
 void ScanIntake::publish_plans(std::vector<PlanRecord> plans, const std::string& first) {
@@ -408,10 +415,17 @@ void ScanIntake::loop() {
     } else {
       StoredScan& scan = *job.scan;
       try {
+        const auto started = std::chrono::steady_clock::now();
         scan = match(scan, job.cloud);
-        process(scan, job.cloud);
-        spdlog::info("scan {} from '{}' is in the map: {} points at ({:.2f}, {:.2f}, {:.2f})",
-                     scan.id, scan.robot, scan.points, scan.placed.x, scan.placed.y, scan.placed.z);
+        const auto matched = std::chrono::steady_clock::now();
+        process(scan, job.cloud, /*restoring=*/false,
+                std::chrono::duration<double, std::milli>(matched - started).count());
+        spdlog::info(
+            "scan {} from '{}' is in the map: {} points at ({:.2f}, {:.2f}, {:.2f}), {:.0f} ms "
+            "after matching",
+            scan.id, scan.robot, scan.points, scan.placed.x, scan.placed.y, scan.placed.z,
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - matched)
+                .count());
       } catch (const std::exception& e) {
         spdlog::error("scan {} could not join the map: {}", scan.id, e.what());
         std::lock_guard lock(mutex_);

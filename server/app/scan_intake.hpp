@@ -110,7 +110,10 @@ class ScanIntake {
   void loop();
   // Brings one stored scan into the live map and tells the browsers; what the pose graph
   // changed is recorded and published unless `restoring` (a restart retracing the session).
-  void process(const StoredScan& scan, const PointCloud& cloud, bool restoring = false);
+  // `match_ms`: how long matching it took (wall clock, with the map's points gathered); none
+  // for a scan brought back after a restart, which is not matched again.
+  void process(const StoredScan& scan, const PointCloud& cloud, bool restoring = false,
+               std::optional<double> match_ms = std::nullopt);
   // plan_done for each plan, by robot id, `first`'s first.
   void publish_plans(std::vector<PlanRecord> plans, const std::string& first);
   // A correction of the map: a revision of the poses in the session and `map_corrected`.

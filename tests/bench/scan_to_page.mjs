@@ -9,15 +9,13 @@
 // (done → scan_received: DDS transfer, the PLY synced), matching (→ match_done), the map, regions,
 // layers and plan (→ plan_done; of which the planner's own plan_ms), the page (→ candidates
 // shown), and the scan's chunk drawn in the 3-D view (plan_done → drawn). Prints one JSON line. Usage: tests/bench/scan_to_page.sh [SCANS] [ROBOTS]
-import { mkdtempSync, readFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join } from 'node:path';
-import { requestScan, startStack, worldVariant } from '../support/stack.mjs';
+import { readFileSync } from 'node:fs';
+import { requestScan, scratchDir, startStack, worldVariant } from '../support/stack.mjs';
 import { openPage, withBrowser } from '../support/browser.mjs';
 
 const scans = Number(process.argv[2] || 15);
 const robots = Number(process.argv[3] || 1);
-const { file } = worldVariant(mkdtempSync(join(tmpdir(), 'scanplan-latency-')), 'campus.json', {});
+const { file } = worldVariant(scratchDir('scanplan-latency-'), 'campus.json', {});
 const { bounds } = JSON.parse(readFileSync(file, 'utf8'));
 const stack = await startStack({ world: file });
 const median = (v) => {

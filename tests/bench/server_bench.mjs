@@ -75,6 +75,7 @@ try {
     const q = `x=${x + gauss()}&y=${y + gauss()}&z=${z}&yaw_deg=${yaw + 5 * gauss()}`;
     const planned = nextEvent((e) => e.type === 'plan_done' && e.based_on_scan === k + 1);
     const matched = nextEvent((e) => e.type === 'match_done' && e.scan === k + 1);
+    const updated = nextEvent((e) => e.type === 'map_updated' && e.scan === k + 1);
     const t0 = performance.now();
     const r = await stack.api('POST', `/api/v1/scans?${q}`, { body });
     if (r.status !== 201) throw new Error(`POST answered ${r.status}: ${await r.text()}`);
@@ -82,6 +83,8 @@ try {
     const { e: plan, at } = await planned;
     // The first scan has nothing to be matched against.
     const match = k > 0 ? (await matched).e : null;
+    // Where the server's time went (map_updated's stages_ms: match, graph, map, thin, plan, layers).
+    const stages = (await updated).e.stages_ms;
     // A real scan takes a minute: by the next one the server has long re-encoded the whole
     // map. Wait for that here too, so that each scan meets the idle server a robot would find.
     let wholeAt = null;
@@ -102,7 +105,8 @@ try {
     rows.push({ scan: k + 1, points: info.points, ply_mb: body.length / 1e6, ms_to_stored: stored - t0,
       ms_to_candidates: at - t0, ms_match: match?.time_ms ?? 0, match_applied: match?.applied ?? null,
       ms_plan: plan.plan_ms, candidates: plan.candidates, match_message: match?.message ?? null,
-      ms_to_whole_map: wholeAt === null ? null : wholeAt - t0, placed_error_m: placedErrorM, ...rssKb(stack.server.pid) });
+      ms_to_whole_map: wholeAt === null ? null : wholeAt - t0, placed_error_m: placedErrorM, stages_ms: stages,
+      ...rssKb(stack.server.pid) });
     process.stderr.write(`scan ${k + 1}: ${info.points} points, candidates after ${(at - t0).toFixed(0)} ms, ` +
       `rss ${(rssKb(stack.server.pid).rss / 1024).toFixed(0)} MB\n`);
   }
@@ -135,6 +139,8 @@ console.log(JSON.stringify({
     .map((part) => ({ scans: `${part[0].scan}-${part.at(-1).scan}`,
       ms_to_candidates_median: median(part.map((r) => r.ms_to_candidates)),
       ms_plan_median: median(part.map((r) => r.ms_plan)),
+      stage_ms_median: Object.fromEntries(['match', 'graph', 'map', 'thin', 'plan', 'layers']
+        .map((k) => [k, median(part.map((r) => r.stages_ms?.[k] ?? 0))])),
       rss_mb_end: part.at(-1).rss / 1024 })),
   rows,
 }));

@@ -6,10 +6,7 @@
 // Screenshots: $SCREENSHOT_DIR (build/screenshots under ctest).
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join } from 'node:path';
-import { requestScan, scanAndWait, startStack, worldVariant } from '../support/stack.mjs';
+import { requestScan, scanAndWait, startStack, worldVariant, scratchDir } from '../support/stack.mjs';
 import {
   canvasCoverage,
   dataset,
@@ -24,7 +21,7 @@ import {
 let stack;
 before(async () => {
   // No pose noise: the robot scans exactly where it was sent, so the test checks positions.
-  const { file } = worldVariant(mkdtempSync(join(tmpdir(), 'scanplan-page-')), 'yard.json', {
+  const { file } = worldVariant(scratchDir('scanplan-page-'), 'yard.json', {
     pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
   });
   stack = await startStack({ world: file, timeScale: 600 });

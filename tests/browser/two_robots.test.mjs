@@ -4,15 +4,12 @@
 // Screenshot: $SCREENSHOT_DIR/two_robots.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join } from 'node:path';
-import { requestScan, startStack, worldVariant } from '../support/stack.mjs';
+import { requestScan, startStack, worldVariant, scratchDir } from '../support/stack.mjs';
 import { dataset, frames, openPage, overflowing, screenshot, waitForData, withBrowser } from '../support/browser.mjs';
 
 let stack;
 before(async () => {
-  const { file } = worldVariant(mkdtempSync(join(tmpdir(), 'scanplan-two-')), 'yard.json', {
+  const { file } = worldVariant(scratchDir('scanplan-two-'), 'yard.json', {
     pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
   });
   // Slow enough that robot1 is still driving while the page is checked (a 30 m drive: 3 s).

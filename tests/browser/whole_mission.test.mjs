@@ -5,17 +5,15 @@
 // the page and checked against each other and the session. Screenshot: whole_mission.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync, readFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join } from 'node:path';
-import { requestScan, startStack, worldVariant } from '../support/stack.mjs';
+import { readFileSync } from 'node:fs';
+import { requestScan, startStack, worldVariant, scratchDir } from '../support/stack.mjs';
 import { frames, openPage, screenshot, waitForData, withBrowser } from '../support/browser.mjs';
 
 const MAX_SCANS = 40;
 let stack;
 let world;
 before(async () => {
-  ({ file: world } = worldVariant(mkdtempSync(join(tmpdir(), 'scanplan-mission-')), 'campus.json', {}));
+  ({ file: world } = worldVariant(scratchDir('scanplan-mission-'), 'campus.json', {}));
   stack = await startStack({ world });
   const { bounds } = JSON.parse(readFileSync(world, 'utf8'));
   const target = [bounds.min, [bounds.max[0], bounds.min[1]], bounds.max, [bounds.min[0], bounds.max[1]]];

@@ -3,14 +3,11 @@
 // the approval, and viewers cannot decide.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join } from 'node:path';
-import { startStack, scanAndWait, worldVariant } from '../support/stack.mjs';
+import { startStack, scanAndWait, worldVariant, scratchDir } from '../support/stack.mjs';
 
 let stack;
 before(async () => {
-  const { file } = worldVariant(mkdtempSync(join(tmpdir(), 'scanplan-approval-')), 'yard.json', {
+  const { file } = worldVariant(scratchDir('scanplan-approval-'), 'yard.json', {
     pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
   });
   stack = await startStack({ world: file });

@@ -46,15 +46,21 @@ test('a scan arrives as events and a binary map chunk', async () => {
     else events.push(JSON.parse(data.toString()));
   });
   const session = await scanAndWait(stack, 1);
-  await stack.waitFor('plan_done and the chunk', async () =>
-    events.some((e) => e.type === 'plan_done') && chunks.length > 0, 30000);
+  await stack.waitFor('plan_done, the chunk and map_updated', async () =>
+    events.some((e) => e.type === 'plan_done') && chunks.length > 0 && events.some((e) => e.type === 'map_updated'), 30000);
   ws.close();
 
   const types = new Set(events.map((e) => e.type));
   for (const t of ['scan_progress', 'scan_received', 'map_updated', 'plan_done']) assert.ok(types.has(t), t);
   const done = events.find((e) => e.type === 'scan_progress' && e.state === 'done');
   assert.equal(done.fraction, 1);
-  assert.equal(events.find((e) => e.type === 'map_updated').scan, 1);
+  const updated = events.find((e) => e.type === 'map_updated');
+  assert.equal(updated.scan, 1);
+  // Where the server's time went: every stage is a duration, and the plan is the planner's.
+  for (const stage of ['match', 'graph', 'map', 'thin', 'plan', 'layers']) {
+    assert.ok(updated.stages_ms[stage] >= 0 && updated.stages_ms[stage] < 60000, `${stage}: ${updated.stages_ms[stage]}`);
+  }
+  assert.ok(updated.stages_ms.plan >= events.find((e) => e.type === 'plan_done').plan_ms);
 
   const chunk = chunks[0];
   assert.equal(chunk.readUInt8(0), 1, 'op 1: map chunk');

@@ -3,14 +3,13 @@
 // from the formats' specifications (not the server's code).
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync, readFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
+import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
-import { requireEnv, runCli, scanAndWait, startStack, worldVariant } from '../support/stack.mjs';
+import { requireEnv, runCli, scanAndWait, startStack, worldVariant, scratchDir } from '../support/stack.mjs';
 
 let stack;
 before(async () => {
-  const { file } = worldVariant(mkdtempSync(join(tmpdir(), 'scanplan-exports-')), 'yard.json', {
+  const { file } = worldVariant(scratchDir('scanplan-exports-'), 'yard.json', {
     pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
   });
   stack = await startStack({ world: file });
@@ -161,7 +160,7 @@ test('the map, the poses and the annotations read back as their formats say', as
 });
 
 test('the terminal operator saves an export to a file', async () => {
-  const out = join(mkdtempSync(join(tmpdir(), 'scanplan-export-cli-')), 'poses.csv');
+  const out = join(scratchDir('scanplan-export-cli-'), 'poses.csv');
   const run = (args) => runCli(stack, args, stack.viewerToken);
   const r = await run(['export', 'poses.csv', '--out', out]);
   assert.equal(r.code, 0, r.stderr);

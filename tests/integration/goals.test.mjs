@@ -4,14 +4,11 @@
 // caller's role, each scan's areas for the coverage chart, and map.drc?since=&until= for one scan.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join } from 'node:path';
-import { scanAndWait, startStack, worldVariant } from '../support/stack.mjs';
+import { scanAndWait, startStack, worldVariant, scratchDir } from '../support/stack.mjs';
 
 let stack;
 before(async () => {
-  const { file } = worldVariant(mkdtempSync(join(tmpdir(), 'scanplan-goals-')), 'yard.json', {
+  const { file } = worldVariant(scratchDir('scanplan-goals-'), 'yard.json', {
     pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
   });
   stack = await startStack({ world: file });

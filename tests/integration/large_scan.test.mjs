@@ -2,10 +2,9 @@
 // where every beam returns, at a finer angular step than the default.
 import { test, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync, writeFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
+import { writeFileSync } from 'node:fs';
 import { join } from 'node:path';
-import { startStack, scanAndWait } from '../support/stack.mjs';
+import { startStack, scanAndWait, scratchDir } from '../support/stack.mjs';
 
 const wall = [120, 120, 120];
 const room = {
@@ -30,7 +29,7 @@ let stack;
 after(async () => stack && (await stack.stop()));
 
 test(`a ${expected}-point scan arrives whole`, async () => {
-  const dir = mkdtempSync(join(tmpdir(), 'scanplan-room-'));
+  const dir = scratchDir('scanplan-room-');
   const file = join(dir, 'room.json');
   writeFileSync(file, JSON.stringify(room));
   stack = await startStack({ world: file });

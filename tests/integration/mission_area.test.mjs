@@ -3,17 +3,14 @@
 // server restarted on the session plans with them as before.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join } from 'node:path';
-import { runCli, scanAndWait, startStack, worldVariant } from '../support/stack.mjs';
+import { runCli, scanAndWait, startStack, worldVariant, scratchDir } from '../support/stack.mjs';
 
 // Runs `scanplan args…` against the stack: { code, stdout, stderr }.
 const cli = (args, token) => runCli(stack, args, token);
 
 let stack;
 before(async () => {
-  const { file } = worldVariant(mkdtempSync(join(tmpdir(), 'scanplan-area-')), 'yard.json', {
+  const { file } = worldVariant(scratchDir('scanplan-area-'), 'yard.json', {
     pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
   });
   stack = await startStack({ world: file });

@@ -3,10 +3,7 @@
 // approved on its own, and each robot's plan and goal on its own ROS 2-namespaced topics.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join } from 'node:path';
-import { startStack, worldVariant } from '../support/stack.mjs';
+import { startStack, worldVariant, scratchDir } from '../support/stack.mjs';
 import { startListener } from '../support/dds_listener.mjs';
 
 // robot1 starts at the yard's start (-15, -8); robot2 in the south-east corner, across the yard.
@@ -16,7 +13,7 @@ const KEEP_APART_M = 10; // PlannerConfig::claim_separation_m
 let stack;
 let listener;
 before(async () => {
-  const { file } = worldVariant(mkdtempSync(join(tmpdir(), 'scanplan-robots-')), 'yard.json', {
+  const { file } = worldVariant(scratchDir('scanplan-robots-'), 'yard.json', {
     pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },
   });
   // Slow enough (a 30 m drive takes 3 s) that robot1 is still driving when robot2 is approved.

@@ -4,17 +4,16 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { mkdtempSync, writeFileSync, readFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
+import { writeFileSync, readFileSync } from 'node:fs';
 import { join } from 'node:path';
-import { startStack, scanAndWait, requestScan, requireEnv, runCli } from '../support/stack.mjs';
+import { startStack, scanAndWait, requestScan, requireEnv, runCli, scratchDir } from '../support/stack.mjs';
 
 const cli = requireEnv('SCANPLAN_CLI');
 const world = join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples/worlds/yard.json');
 let dir, recorded, stack;
 
 before(() => {
-  dir = mkdtempSync(join(tmpdir(), 'scanplan-replay-'));
+  dir = scratchDir('scanplan-replay-');
   recorded = [[-15, -8, 0, 0], [10, -15, 0, 90]].map(([x, y, z, yaw], i) => {
     const out = join(dir, `scan${i}.ply`);
     const json = execFileSync(cli, ['scan', '--world', world, '--at', `${x},${y},${z},${yaw}`,

@@ -4,9 +4,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { createRequire } from 'node:module';
 import { join } from 'node:path';
-import { startStack, scanAndWait, worldVariant, requireEnv } from '../support/stack.mjs';
-import { mkdtempSync } from 'node:fs';
-import { tmpdir } from 'node:os';
+import { startStack, scanAndWait, worldVariant, requireEnv, scratchDir } from '../support/stack.mjs';
 
 const webRequire = createRequire(join(requireEnv('SCANPLAN_SOURCE_DIR'), 'web', 'package.json'));
 const draco3d = webRequire('draco3d');
@@ -39,7 +37,7 @@ async function decodeDraco(bytes) {
 
 let stack;
 before(async () => {
-  const dir = mkdtempSync(join(tmpdir(), 'scanplan-world-'));
+  const dir = scratchDir('scanplan-world-');
   // Exact reported poses, so the map's bounds are the yard's walls to within the range noise.
   const { file } = worldVariant(dir, 'yard.json', {
     pose_noise: { model: 'absolute', xy_sigma_m: 0, z_sigma_m: 0, yaw_sigma_deg: 0 },

@@ -19,6 +19,17 @@ export function requireEnv(name) {
   return v;
 }
 
+// A temporary directory that is removed when the test process exits, however it ends.
+const scratch = [];
+process.on('exit', () => {
+  for (const dir of scratch) rmSync(dir, { recursive: true, force: true });
+});
+export function scratchDir(prefix) {
+  const dir = mkdtempSync(join(tmpdir(), prefix));
+  scratch.push(dir);
+  return dir;
+}
+
 // A copy of a sample world with overrides, e.g. exact poses for a test that checks geometry.
 export function worldVariant(dir, sampleName, overrides) {
   const src = join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples', 'worlds', sampleName);
@@ -150,7 +161,7 @@ export async function scanAndWait(stack, count) {
 // A stack whose bridge replays one recorded yard scan taken at (−15, −8) (such a bridge cannot
 // drive: it refuses every move), with that scan in the session and its plan made.
 export async function startOneScanReplay() {
-  const dir = mkdtempSync(join(tmpdir(), 'scanplan-replay-'));
+  const dir = scratchDir('scanplan-replay-');
   execFileSync(requireEnv('SCANPLAN_CLI'), ['scan', '--world', join(requireEnv('SCANPLAN_SOURCE_DIR'), 'samples/worlds/yard.json'),
     '--at', '-15,-8,0,0', '--out', join(dir, 'scan0.ply'), '--seed', '1'], { stdio: 'ignore' });
   writeFileSync(join(dir, 'poses.csv'), 'file,x,y,z,yaw_deg\nscan0.ply,-15,-8,0,0\n');

@@ -1,5 +1,7 @@
 #include "scanplan/mission/mission_pipeline.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <utility>
 
@@ -13,6 +15,11 @@ constexpr double kNoticeableDeg = 0.01;
 struct PoseChange {
   double metres = 0, degrees = 0;
 };
+
+using Clock = std::chrono::steady_clock;
+double ms_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
 
 PoseChange change(const Pose& a, const Pose& b) {
   return {std::hypot(b.x - a.x, b.y - a.y, b.z - a.z),
@@ -84,8 +91,8 @@ std::optional<MissionPipeline::MatchInput> MissionPipeline::match_input(
     }
   }
   MatchInput in{{}, config, start, {{}, scanner_view()}};
-  in.map_points = points_near(start.x, start.y, config.target_radius_m, /*anchored_only=*/true,
-                              &in.views.target);
+  in.map_points = points_of(match_sources(start.x, start.y, config.target_radius_m), start.x,
+                            start.y, config.target_radius_m, &in.views.target);
   return in;
 }
 
@@ -118,6 +125,7 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
                           std::shared_ptr<const PointCloud> in_map) {
   const bool anchored = placed_.empty() || where.matched;
   anchored_.push_back(anchored ? 1 : 0);
+  cloud_bounds_.push_back(bounds_of(*in_map));
   placed_.push_back(std::move(in_map));
   reported_.push_back(where.reported);
   poses_.push_back(where.placed);
@@ -130,6 +138,7 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
     return;
   }
   const std::vector<Pose> before = poses_;
+  const auto t0 = Clock::now();
   const std::optional<SensorFix> fix = where.matched ? std::nullopt : sensors_place(where);
   GraphUpdate update = graph_->add(scan, where, where.matched && unsure(where), scanner_view());
   const std::size_t k = placed_.size() - 1;
@@ -137,9 +146,15 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
     graph_->anchor_by_sensors(k, fix->from, fix->information);
     update.solve = graph_->solve();
   }
+  const auto t1 = Clock::now();
   follow_graph();
-  if (rematch_refused(update)) follow_graph();
+  const auto t2 = Clock::now();
+  const bool rematched = rematch_refused(update);
+  const auto t3 = Clock::now();
+  if (rematched) follow_graph();
   last_correction_ = correction(update, before);
+  last_correction_->graph_ms = ms_between(t0, t1) + ms_between(t2, t3);
+  last_correction_->map_ms = ms_between(t1, t2) + ms_between(t3, Clock::now());
 }
 
 void MissionPipeline::join_map(const PointCloud& own, std::size_t i) {
@@ -223,18 +238,23 @@ bool MissionPipeline::rematch_refused(GraphUpdate& update) {
   for (std::size_t u = 0; u + 1 < placed_.size(); ++u) {  // the newest was matched just now
     if (anchored_[u]) continue;
     const Pose& at = poses_[u];
-    std::size_t near = 0;
-    for (std::size_t j = 0; j < placed_.size(); ++j) {
-      near += anchored_[j] && std::hypot(poses_[j].x - at.x, poses_[j].y - at.y) <= radius;
-    }
+    const std::vector<std::size_t> sources = match_sources(at.x, at.y, radius);
+    // Only places scanned anew count: a scan taken again where one was changes nothing the
+    // match would see (match_sources), and retrying every refused scan near it at each pass of
+    // a long mission made one scan cost seconds.
+    const auto near =
+        static_cast<std::size_t>(std::count_if(sources.begin(), sources.end(), [&](std::size_t j) {
+          return std::hypot(poses_[j].x - at.x, poses_[j].y - at.y) <= radius;
+        }));
     if (near <= anchored_near_[u]) continue;
     anchored_near_[u] = near;
     ++update.rematches_tried;
+    const auto started = Clock::now();
     MatchViews views{{}, scanner_view()};
-    const PointCloud around =
-        points_near(at.x, at.y, radius, /*anchored_only=*/true, &views.target);
+    const PointCloud around = points_of(sources, at.x, at.y, radius, &views.target);
     const MapMatch m = match_to_map(around, graph_->thinned(u), level(at),
                                     widened(*config_.matching, graph_->uncertainty(u)), views);
+    update.rematch_ms += ms_between(started, Clock::now());
     if (!m.applied) continue;
     if (beyond_reach(graph_->uncertainty(u)) ||
         change(at, m.placed).metres > config_.matching->max_correction_m) {
@@ -289,8 +309,7 @@ void MissionPipeline::follow_graph() {
   for (std::size_t i = 0; i < placed_.size(); ++i) {
     const PoseChange d = change(cloud_poses_[i], poses_[i]);
     if (d.metres > kNoticeableM || d.degrees > kNoticeableDeg) {
-      placed_[i] = to_map_frame(own_frame(i), poses_[i]);
-      cloud_poses_[i] = poses_[i];
+      set_cloud(i, to_map_frame(own_frame(i), poses_[i]));
     }
   }
 }
@@ -310,8 +329,7 @@ void MissionPipeline::replace() {
     if (!moved && !anchored_[i]) continue;  // its points stay as they are, outside the map
     PointCloud own = own_frame(i);
     if (moved) {
-      placed_[i] = to_map_frame(own, poses_[i]);
-      cloud_poses_[i] = poses_[i];
+      set_cloud(i, to_map_frame(own, poses_[i]));
     }
     if (anchored_[i]) join_map(own, i);
   }
@@ -397,13 +415,52 @@ void MissionPipeline::set_target(TargetRegion target) {
 
 PointCloud MissionPipeline::points_near(double x, double y, double radius_m, bool anchored_only,
                                         Viewpoints* views) const {
+  std::vector<std::size_t> scans;
+  for (std::size_t i = 0; i < placed_.size(); ++i) {
+    if ((!anchored_only || anchored_[i]) && reaches(i, x, y, radius_m)) scans.push_back(i);
+  }
+  return points_of(scans, x, y, radius_m, views);
+}
+
+bool MissionPipeline::reaches(std::size_t i, double x, double y, double radius_m) const {
+  const Bounds3& b = cloud_bounds_[i];
+  if (!b.valid()) return false;
+  const double dx = std::max({b.min.x() - x, 0.0, x - b.max.x()});
+  const double dy = std::max({b.min.y() - y, 0.0, y - b.max.y()});
+  return dx * dx + dy * dy <= radius_m * radius_m;
+}
+
+// The anchored scans a match near (x, y) is made against: those with points within `radius_m`,
+// less each one a later anchored scan was taken within kSameViewM of. A place scanned again
+// (a later pass over the site, a second robot) shows the same surfaces from the same spot;
+// matched against both, a scan meets every surface twice, and on a long session pass after
+// pass the match input grew with the session (200 campus scans: seconds a scan, issue 19).
+// The latest scan of a place stays: it shows the scene as it is now.
+std::vector<std::size_t> MissionPipeline::match_sources(double x, double y, double radius_m) const {
+  std::vector<std::size_t> out;
+  std::vector<Eigen::Vector3d> taken;
+  for (std::size_t i = placed_.size(); i-- > 0;) {
+    if (!anchored_[i] || !reaches(i, x, y, radius_m)) continue;
+    const Eigen::Vector3d at(poses_[i].x, poses_[i].y, poses_[i].z);
+    if (std::any_of(taken.begin(), taken.end(),
+                    [&](const Eigen::Vector3d& t) { return (t - at).norm() < kSameViewM; })) {
+      continue;
+    }
+    taken.push_back(at);
+    out.push_back(i);
+  }
+  std::reverse(out.begin(), out.end());  // in joining order, as the map holds them
+  return out;
+}
+
+PointCloud MissionPipeline::points_of(const std::vector<std::size_t>& scans, double x, double y,
+                                      double radius_m, Viewpoints* views) const {
   PointCloud out;
   if (views) *views = {};
   const Eigen::Vector2f c(static_cast<float>(x), static_cast<float>(y));
   const float r2 = static_cast<float>(radius_m * radius_m);
   const Eigen::Vector3f sensor = scanner_view().origins.front();
-  for (std::size_t i = 0; i < placed_.size(); ++i) {
-    if (anchored_only && !anchored_[i]) continue;
+  for (const std::size_t i : scans) {
     const std::size_t before = out.size();
     for (const auto& p : placed_[i]->points) {
       if ((p.head<2>() - c).squaredNorm() <= r2) out.points.push_back(p);
@@ -415,6 +472,12 @@ PointCloud MissionPipeline::points_near(double x, double y, double radius_m, boo
     }
   }
   return out;
+}
+
+void MissionPipeline::set_cloud(std::size_t i, std::shared_ptr<const PointCloud> in_map) {
+  cloud_bounds_[i] = bounds_of(*in_map);
+  placed_[i] = std::move(in_map);
+  cloud_poses_[i] = poses_[i];
 }
 
 Viewpoints MissionPipeline::scanner_view() const {

@@ -2,6 +2,7 @@
 // segmented and planned from, on the yard world with known true poses.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "ground_pose.hpp"
@@ -109,6 +110,39 @@ TEST_F(MissionPipelineTest, OnlyAnchoredScansAreMatchedAgainst) {
   ASSERT_EQ(both.origins.size(), 2u);
   EXPECT_TRUE(both.origins[1].isApprox(Eigen::Vector3f(-3, -7, mount)));
   EXPECT_EQ(both.of(near.size() - 1), both.origins[1]) << "the refused scan's points come last";
+}
+
+// A place scanned again (a later pass, a second robot): a match near it is made against the
+// latest scan there alone, so the match's input stays the size of the site, not of the session.
+TEST_F(MissionPipelineTest, APlaceScannedAgainIsMatchedAgainstItsLatestScanOnly) {
+  MissionConfig without_graph = config();
+  without_graph.graph.reset();
+  MissionPipeline mission(without_graph);
+  const Pose first = at(-15, -8, 0), again = at(-15.4, -8.3, 40), apart = at(-12, -8, 0);
+  mission.add(scan_at(first, 1), {first, first});
+  mission.add(scan_at(again, 2), {again, again, /*matched=*/true});
+  const auto mount = static_cast<float>(without_graph.mapping.sensor_height_m);
+  const auto origins = [&](const Pose& from) {
+    const auto in = mission.match_input(from);
+    EXPECT_TRUE(in && in->views.target.fit(in->map_points.size()));
+    return in ? in->views.target.origins : std::vector<Eigen::Vector3f>{};
+  };
+  std::vector<Eigen::Vector3f> seen = origins(at(-5, -9, 0));
+  ASSERT_EQ(seen.size(), 1u) << "the first scan's place was scanned again half a metre off";
+  EXPECT_TRUE(seen[0].isApprox(Eigen::Vector3f(-15.4F, -8.3F, mount), 1e-3F));
+  const auto in = mission.match_input(at(-5, -9, 0));
+  const auto within =
+      std::count_if(mission.placed_scans()[1]->points.begin(),
+                    mission.placed_scans()[1]->points.end(), [&](const Eigen::Vector3f& p) {
+                      return std::hypot(p.x() + 5, p.y() + 9) <= in->config.target_radius_m;
+                    });
+  EXPECT_EQ(in->map_points.size(), static_cast<std::size_t>(within)) << "the second scan's alone";
+
+  // Three metres on is another place: both are matched against.
+  mission.add(scan_at(apart, 3), {apart, apart, /*matched=*/true});
+  seen = origins(at(-5, -9, 0));
+  ASSERT_EQ(seen.size(), 2u);
+  EXPECT_TRUE(seen[1].isApprox(Eigen::Vector3f(-12, -8, mount), 1e-3F));
 }
 
 // With the graph, a scan the map match refused is matched pairwise with the anchored scans

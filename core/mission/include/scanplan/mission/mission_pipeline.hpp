@@ -49,6 +49,9 @@ struct MapCorrection {
   // until they add up.
   std::vector<std::size_t> moved;
   double max_moved_m = 0, max_turned_deg = 0;
+  // Where the scan's joining went (wall clock): the graph (its pairs, the refused scans matched
+  // again, the solve) and the map following it (the MLS map, segmentation, movable region).
+  double graph_ms = 0, map_ms = 0;
 };
 
 // The paper's loop as one object (§3 steps 1–4 with §4's matching), used alike by the server
@@ -63,7 +66,9 @@ class MissionPipeline {
   // Placed: where scan `scan` (its own frame) goes, matched from its reported pose carried into
   // the map frame (prior(); a refused match leaves it there) against the points near it
   // (MapMatchConfig::target_radius_m) of the anchored scans: the first, which defines the map
-  // frame, and those placed by a match the sanity check believed. A scan left unmatched is
+  // frame, and those placed by a match the sanity check believed; of scans taken within a
+  // metre of each other, the latest alone (the same surfaces twice cost time, and a long
+  // session's passes over one site made the match grow with it). A scan left unmatched is
   // metres off as often as not; matched against, it would pull every later scan near it off
   // with it. Nothing when matching is off or nothing is anchored yet. Changes nothing.
   std::optional<MapMatch> place(const PointCloud& scan, const Pose& reported,
@@ -159,9 +164,10 @@ class MissionPipeline {
   // kept only while matching is on.
   std::optional<MlsMap> anchored_map_;
   SensorFrame sensor_frame_;
-  std::vector<Pose> reported_;     // per scan, for refitting sensor_frame_
-  std::vector<Pose> poses_;        // per scan: where it is (the graph's estimate)
-  std::vector<Pose> cloud_poses_;  // per scan: the pose its placed_ points were put at
+  std::vector<Pose> reported_;         // per scan, for refitting sensor_frame_
+  std::vector<Pose> poses_;            // per scan: where it is (the graph's estimate)
+  std::vector<Pose> cloud_poses_;      // per scan: the pose its placed_ points were put at
+  std::vector<Bounds3> cloud_bounds_;  // per scan: its placed_ points' bounds
   std::vector<std::uint8_t> in_map_;
   std::vector<std::optional<Eigen::Vector3d>> goals_;  // per scan: Placement::goal
   std::optional<ScanGraph> graph_;
@@ -181,6 +187,8 @@ class MissionPipeline {
   // within this: the accuracy the map is built to (issue 17's target).
   static constexpr double kSensorsPlaceM = 0.05;
   static constexpr double kSensorsPlaceDeg = 0.1;
+  // Two scans taken this close see the same surfaces from the same spot (match_sources).
+  static constexpr double kSameViewM = 1.0;
   struct SensorFix {
     std::size_t from = 0;  // the scan the sensors relate it to
     Eigen::Matrix4d information;
@@ -192,6 +200,11 @@ class MissionPipeline {
   void follow_graph();
   void join_map(const PointCloud& own, std::size_t i);
   PointCloud own_frame(std::size_t i) const;
+  bool reaches(std::size_t i, double x, double y, double radius_m) const;
+  std::vector<std::size_t> match_sources(double x, double y, double radius_m) const;
+  PointCloud points_of(const std::vector<std::size_t>& scans, double x, double y, double radius_m,
+                       Viewpoints* views) const;
+  void set_cloud(std::size_t i, std::shared_ptr<const PointCloud> in_map);
   MapCorrection correction(const GraphUpdate& update, const std::vector<Pose>& before) const;
   void replace();
 };
