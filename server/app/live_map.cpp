@@ -116,7 +116,7 @@ std::optional<MapMatch> LiveMap::place(const PointCloud& scan, const Pose& repor
   return match_to_map(in->map_points, scan, in->prior, in->config, in->views);
 }
 
-LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud, bool settled) {
+LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
   // The scan in the map frame first: should it fail (out of memory), nothing of the scan has
   // reached the map yet. Its Draco chunk (~25 ms for a campus scan) is made when first asked
   // for (encoded_chunk), after the plan has gone out: the operator waits for the candidates.
@@ -125,7 +125,7 @@ LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud, boo
   // they see the scan, its points and the plan that includes it appear together.
   std::lock_guard encode_lock(encode_mutex_);
   const auto join_start = Clock::now();
-  mission_.add(cloud, placement_of(scan), shared, settled);
+  mission_.add(cloud, placement_of(scan), shared);
   const double join_ms = ms_between(join_start, Clock::now());
   // Only writers change the scans, under encode_mutex_ (held): read without mutex_.
   std::vector<StoredScan> scans = scans_;
@@ -166,46 +166,6 @@ LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud, boo
   return out;
 }
 
-std::optional<LiveMap::Added> LiveMap::settle() {
-  std::lock_guard encode_lock(encode_mutex_);
-  const auto start = Clock::now();
-  if (!mission_.settle()) return std::nullopt;
-  const double join_ms = ms_between(start, Clock::now());
-  // Only writers change the scans, under encode_mutex_ (held): read without mutex_.
-  Followed f = follow_mission(scans_, placed_, in_map_, /*newest_joined=*/false);
-  Added out;
-  out.in_map = f.in_map.back() != 0;
-  out.corrected = f.corrected;
-  if (const auto& graph = mission_.last_correction()) out.times.graph = graph->graph_ms;
-  out.times.map = join_ms - out.times.graph;
-  if (f.corrected.poses.empty()) return out;
-  const MapCorrected& c = f.corrected;
-  const std::int64_t newest = f.scans.back().id;
-  const bool only_newest_joined = c.joined.size() == 1 && c.joined.front() == newest;
-  const auto thin_start = Clock::now();
-  if (!c.left.empty() || c.max_moved_m > kThinnedMapVoxelM / 3 ||
-      (!c.joined.empty() && !only_newest_joined)) {
-    rethin(f, /*whole=*/true);
-  } else if (only_newest_joined) {
-    rethin(f, /*whole=*/false);
-  }
-  out.times.thin = ms_between(thin_start, Clock::now());
-  follow_robots(f);
-  if (c.empty()) {
-    // Only scans outside the map moved: nothing the plans or layers show changed.
-    std::lock_guard lock(mutex_);
-    commit(std::move(f));
-    return out;
-  }
-  out.plans = refresh_derived([&] { commit(std::move(f)); }, /*scan_joined=*/true, &out.times);
-  encode_wanted_.notify_one();
-  if (on_map) on_map(thinned_.cloud());
-  if (on_plan) {
-    for (const PlanRecord& plan : out.plans) on_plan(plan);
-  }
-  return out;
-}
-
 void LiveMap::follow_robots(const Followed& f) {
   // A robot stands where it last scanned; while that scan waits outside the map (metres off,
   // perhaps), it is planned from its latest scan in the map, as the map can place it.
@@ -221,8 +181,7 @@ void LiveMap::follow_robots(const Followed& f) {
 
 LiveMap::Followed LiveMap::follow_mission(std::vector<StoredScan> scans,
                                           std::vector<std::shared_ptr<const PointCloud>> placed,
-                                          std::vector<std::uint8_t> in_map,
-                                          bool newest_joined) const {
+                                          std::vector<std::uint8_t> in_map) const {
   Followed f;
   const MissionConfig& config = mission_.config();
   const std::size_t newest = scans.size() - 1;
@@ -239,7 +198,7 @@ LiveMap::Followed LiveMap::follow_mission(std::vector<StoredScan> scans,
     }
     in_map[i] = now_in ? 1 : 0;
     MapCorrected& c = f.corrected;
-    if (newest_joined && i == newest) {
+    if (i == newest) {
       if (moved || !now_in) c.poses.push_back({scans[i].id, now, now_in});
       continue;
     }
@@ -624,10 +583,7 @@ LiveMap::Rebuilt LiveMap::rebuild(const std::vector<StoredScan>& keep, const Sca
         continue;
       }
     }
-    // In the steps the live map took (add, then settle): the same poses.
-    fresh.add(own, placement_of(s), MissionPipeline::to_map_frame(own, s.placed),
-              /*settled=*/false);
-    fresh.settle();
+    fresh.add(own, placement_of(s));
     scans.push_back(s);
     if (progress) progress(scans.size());
   }

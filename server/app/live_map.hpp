@@ -107,6 +107,12 @@ class LiveMap {
   std::function<void(const PointCloud& thinned_map)> on_map;
   std::function<void(const PlanRecord& plan)> on_plan;
 
+  // A stored scan joins the map: `cloud` is in the scan's own frame, `scan.placed` puts it in
+  // the map frame (where its match put it; scan.match's information weighs it in the pose
+  // graph). Scans must come in id order. Returns the plans made after it (one per robot not
+  // driving to a goal; the scanning robot's last) and what the pose graph changed.
+  // With the graph, a scan no believed match ties in waits outside the map (waiting()): its
+  // points are in no map encoding, thinned map or bounds until it joins.
   // Where adding a scan went, wall clock in ms: the pose graph (pairs, refused scans matched
   // again, the solve), the map following it (MLS map, segmentation, movable region), the
   // thinned map, the plans, the layers' images.
@@ -119,20 +125,7 @@ class LiveMap {
     bool in_map = true;  // the new scan joined the map (with the graph, it may wait outside)
     AddTimes times;
   };
-  // A stored scan joins the map: `cloud` is in the scan's own frame, `scan.placed` puts it in
-  // the map frame (where its match put it; scan.match's information weighs it in the pose
-  // graph). Scans must come in id order. Returns the plans made after it (one per robot not
-  // driving to a goal; the scanning robot's last) and what the pose graph changed.
-  // With the graph, a scan no believed match ties in waits outside the map (waiting()): its
-  // points are in no map encoding, thinned map or bounds until it joins.
-  // `settled` false leaves the graph's slow part (MissionPipeline::add) for settle(): the plans
-  // come out first.
-  Added add(const StoredScan& scan, const PointCloud& cloud, bool settled = true);
-  // The graph's slow part for the scan add() left it for: its pairwise matches and refused
-  // scans matched again. Where that changed the map (scans tied in, the new one among them,
-  // moved or set outside), the map follows and the plans are made anew, returned here (none
-  // when the map stayed as it was), with the change. Nothing when there was nothing left.
-  std::optional<Added> settle();
+  Added add(const StoredScan& scan, const PointCloud& cloud);
 
   // The map made anew from `keep` (stored scans, in id order, at their placed poses): after the
   // operator took a scan out or put one back. Points of scans the map holds are reused; the
@@ -258,10 +251,10 @@ class LiveMap {
     std::vector<std::int64_t> unencoded;  // ids whose chunk must be made anew
     MapCorrected corrected;
   };
-  // With `newest_joined`, the last of `scans` just joined (its moves are not corrections).
+  // The last of `scans` just joined (its moves are not corrections).
   Followed follow_mission(std::vector<StoredScan> scans,
                           std::vector<std::shared_ptr<const PointCloud>> placed,
-                          std::vector<std::uint8_t> in_map, bool newest_joined = true) const;
+                          std::vector<std::uint8_t> in_map) const;
   // Where each robot is planned from, as `f` has the scans. Needs encode_mutex_ held.
   void follow_robots(const Followed& f);
   // The thinned map of the scans in `f` that are in the map: made anew when `whole` (it cannot

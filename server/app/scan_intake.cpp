@@ -173,41 +173,25 @@ StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
 
 void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud, bool restoring,
                          std::optional<double> match_ms) {
-  // The graph's slow part (pairwise matches, refused scans matched again: seconds where scans
-  // the map does not hold lie around) waits until the plans are out.
-  LiveMap::Added added = live_.add(scan, cloud, /*settled=*/false);
+  LiveMap::Added added = live_.add(scan, cloud);
   // What the operator waits for goes out first: the new candidates (a few kilobytes), then the
   // scan's chunk for the 3-D view (a megabyte on the link, perhaps encoded now).
   publish_plans(std::move(added.plans), scan.robot);
   // A scan waiting outside the map is not shown: it may be metres off.
-  const auto send_chunk = [&] {
+  if (added.in_map) {
     if (const auto chunk = live_.encoded_chunk(scan.id)) events_.map_chunk(scan.id, *chunk);
-  };
-  if (added.in_map) send_chunk();
+  }
   // Brought back after a restart, the graph retraces the corrections already recorded: the
   // session gets one revision once all scans are back (resume_poses).
   if (!restoring) record_correction(added.corrected);
-  LiveMap::AddTimes t = added.times;
-  bool in_map = added.in_map;
-  if (std::optional<LiveMap::Added> settled = live_.settle()) {
-    // Plans made anew only where the rest changed the map; the scan's chunk once it joined.
-    publish_plans(std::move(settled->plans), scan.robot);
-    if (settled->in_map && !in_map) send_chunk();
-    in_map = settled->in_map;
-    if (!restoring) record_correction(settled->corrected);
-    t.graph += settled->times.graph;
-    t.map += settled->times.map;
-    t.thin += settled->times.thin;
-    t.plan += settled->times.plan;
-    t.layers += settled->times.layers;
-  }
   // The scan's last word: a client that saw it has every event of the scan.
   const MapAreas a = live_.areas();
+  const LiveMap::AddTimes& t = added.times;
   nlohmann::json stages = {
       {"graph", t.graph}, {"map", t.map}, {"thin", t.thin}, {"plan", t.plan}, {"layers", t.layers}};
   if (match_ms) stages["match"] = *match_ms;
   spdlog::debug("scan {}: {}", scan.id, stages.dump());
-  events_.publish("map_updated", map_updated_json(scan, a, in_map, std::move(stages)));
+  events_.publish("map_updated", map_updated_json(scan, a, added.in_map, std::move(stages)));
 }
 
 void ScanIntake::publish_plans(std::vector<PlanRecord> plans, const std::string& first) {

@@ -122,8 +122,7 @@ std::shared_ptr<const PointCloud> MissionPipeline::add(const PointCloud& scan,
 }
 
 void MissionPipeline::add(const PointCloud& scan, const Placement& where,
-                          std::shared_ptr<const PointCloud> in_map, bool settled) {
-  if (unsettled_) settle();
+                          std::shared_ptr<const PointCloud> in_map) {
   const bool anchored = placed_.empty() || where.matched;
   anchored_.push_back(anchored ? 1 : 0);
   cloud_bounds_.push_back(bounds_of(*in_map));
@@ -141,40 +140,20 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
   const std::vector<Pose> before = poses_;
   const auto t0 = Clock::now();
   const std::optional<SensorFix> fix = where.matched ? std::nullopt : sensors_place(where);
-  GraphUpdate update =
-      graph_->add(scan, where, where.matched && unsure(where), scanner_view(), settled);
+  GraphUpdate update = graph_->add(scan, where, where.matched && unsure(where), scanner_view());
   const std::size_t k = placed_.size() - 1;
   if (fix && !graph_->anchored(k)) {
     graph_->anchor_by_sensors(k, fix->from, fix->information);
     update.solve = graph_->solve();
   }
-  if (!settled) unsettled_ = k;
-  follow(update, before, t0, /*rematch=*/settled);
-}
-
-bool MissionPipeline::settle() {
-  if (!graph_ || !unsettled_) return false;
-  const std::size_t k = *unsettled_;
-  unsettled_.reset();
-  const std::vector<Pose> before = poses_;
-  const auto t0 = Clock::now();
-  GraphUpdate update = graph_->add_pairs(k);
-  follow(update, before, t0, /*rematch=*/true);
-  return true;
-}
-
-// The map follows what the graph did since `started` (poses `before`), refused scans are
-// matched again when `rematch`, and last_correction_ says what changed and what it cost.
-void MissionPipeline::follow(GraphUpdate& update, const std::vector<Pose>& before,
-                             Clock::time_point started, bool rematch) {
   const auto t1 = Clock::now();
   follow_graph();
   const auto t2 = Clock::now();
-  const bool rematched = rematch && rematch_refused(update);
+  const bool rematched = rematch_refused(update);
   const auto t3 = Clock::now();
   if (rematched) follow_graph();
   last_correction_ = correction(update, before);
-  last_correction_->graph_ms = ms_between(started, t1) + ms_between(t2, t3);
+  last_correction_->graph_ms = ms_between(t0, t1) + ms_between(t2, t3);
   last_correction_->map_ms = ms_between(t1, t2) + ms_between(t3, Clock::now());
 }
 

@@ -119,7 +119,7 @@ std::optional<std::size_t> ScanGraph::last_of(const std::string& track) const {
 }
 
 GraphUpdate ScanGraph::add(const PointCloud& scan, const Placement& where, bool tentative,
-                           const Viewpoints& scanner, bool with_pairs) {
+                           const Viewpoints& scanner) {
   const MoveUncertainty uncertain =
       where.matched && !tentative
           ? MoveUncertainty{}
@@ -133,7 +133,6 @@ GraphUpdate ScanGraph::add(const PointCloud& scan, const Placement& where, bool 
   tracks_.push_back(where.track);
   const bool matched = where.matched && !tentative;
   anchored_.push_back(k == 0 || matched ? 1 : 0);
-  matched_to_map_.push_back(matched ? 1 : 0);
   uncertain_.push_back(uncertain);
   pending_.emplace_back();
   pending_map_.emplace_back();
@@ -143,20 +142,13 @@ GraphUpdate ScanGraph::add(const PointCloud& scan, const Placement& where, bool 
   last_of_track_[where.track] = k;
 
   GraphUpdate update;
-  if (with_pairs) match_pairs(k, matched, update);
+  match_pairs(k, matched, update);
   if (matched) {
     add_match_to_map(k, where.placed, where.information, "map");
     confirm_by_odometry(k);  // the robot's scan before may be waiting for this one
   }
   if (where.matched && tentative) offer_match_to_map(k, where.placed, where.information);
   update.solve = solve();
-  return update;
-}
-
-GraphUpdate ScanGraph::add_pairs(std::size_t scan) {
-  GraphUpdate update;
-  match_pairs(scan, matched_to_map_.at(scan) != 0, update);
-  if (update.pairs_tried > 0) update.solve = solve();
   return update;
 }
 

@@ -29,8 +29,7 @@ class LiveMapGraphTest : public ::testing::Test {
     return c;
   }
   // Scan `id` taken at `truth`, reported at `reported`, matched as the server matches it.
-  LiveMap::Added add(std::int64_t id, const Pose& truth, const Pose& reported, bool match = true,
-                     bool settled = true) {
+  LiveMap::Added add(std::int64_t id, const Pose& truth, const Pose& reported, bool match = true) {
     StoredScan s;
     s.id = id;
     s.robot = "robot1";
@@ -45,7 +44,7 @@ class LiveMapGraphTest : public ::testing::Test {
         s.placed = m->placed;
       }
     }
-    return map_.add(s, cloud, settled);
+    return map_.add(s, cloud);
   }
   PlanBook plans_;
   LiveMap map_;
@@ -94,36 +93,6 @@ TEST_F(LiveMapGraphTest, AScanTiedInLaterJoinsTheMapWhereItBelongs) {
   const Eigen::Vector3d truth = at(-5, -9, 0).isometry() * centroid(own);
   EXPECT_LT((centroid(decoded) - truth).norm(), 0.05);
   EXPECT_GT(map_.point_count(), points_one + decoded.size());
-}
-
-// As the server adds a scan: the plans from its own match first, the graph's pairwise matches
-// after (settle), and the plans made again only where those changed the map.
-TEST_F(LiveMapGraphTest, ThePairwiseMatchesComeAfterThePlans) {
-  add(1, at(-15, -8, 0), at(-15, -8, 0), true, /*settled=*/false);
-  EXPECT_TRUE(map_.settle()) << "the first scan's settling finds nothing to match";
-  const LiveMap::Added second = add(2, at(-5, -9, 0), at(-3, -7, 0), false, /*settled=*/false);
-  EXPECT_FALSE(second.in_map);
-  EXPECT_FALSE(second.plans.empty()) << "planned before its pairs are matched";
-  const std::optional<LiveMap::Added> paired = map_.settle();
-  ASSERT_TRUE(paired);
-  EXPECT_FALSE(paired->in_map) << "one pairwise match is not enough";
-  EXPECT_TRUE(paired->plans.empty()) << "the map did not change: the plans stand";
-  EXPECT_GT(paired->times.graph, second.times.graph) << "the pairwise match is the slow part";
-  EXPECT_FALSE(map_.settle()) << "nothing left";
-
-  const LiveMap::Added third = add(3, at(-12, 4, 30), at(-12, 4, 30), true, /*settled=*/false);
-  EXPECT_TRUE(third.in_map) << "its own match placed it";
-  EXPECT_FALSE(third.plans.empty());
-  EXPECT_EQ(map_.waiting(), std::vector<std::int64_t>{2}) << "the second still waits";
-  const std::optional<LiveMap::Added> tied = map_.settle();
-  ASSERT_TRUE(tied);
-  EXPECT_EQ(tied->corrected.joined, std::vector<std::int64_t>{2});
-  EXPECT_FALSE(tied->plans.empty()) << "planned again on the map the second joined";
-  EXPECT_TRUE(map_.waiting().empty());
-  const auto scans = map_.scans();
-  EXPECT_NEAR(scans[1].placed.x, -5, 0.03);
-  EXPECT_NEAR(scans[1].placed.y, -9, 0.03);
-  EXPECT_TRUE(map_.encoded_chunk(2)) << "its chunk can be fetched";
 }
 
 TEST_F(LiveMapGraphTest, ARebuildKeepsTheGraphsPlacement) {

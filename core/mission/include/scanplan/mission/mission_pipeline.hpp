@@ -1,7 +1,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <chrono>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -96,18 +95,9 @@ class MissionPipeline {
   // optimised; where that moves scans, the map follows (last_correction()), and the points
   // returned are where the scan lay when it joined.
   std::shared_ptr<const PointCloud> add(const PointCloud& scan, const Placement& where);
-  // The same with the points in the map frame already made (to_map_frame). `settled` false
-  // leaves the graph's slow part for settle(): its pairwise matches with the scans the map
-  // does not hold and the refused scans matched again (seconds a scan where several lie
-  // around). In between, the map, and plans made from it, are those of the scan's own match,
-  // which is what an operator waits for; the next add() settles first if settle() was not
-  // called. The graph then takes its steps in another order than add() alone (the pairs after
-  // the map match), so the poses can differ in the last digits.
-  void add(const PointCloud& scan, const Placement& where, std::shared_ptr<const PointCloud> in_map,
-           bool settled = true);
-  // The graph's slow part for the latest scan, if add() left it; the map follows and
-  // last_correction() says what changed. Whether there was anything to do.
-  bool settle();
+  // The same with the points in the map frame already made (to_map_frame).
+  void add(const PointCloud& scan, const Placement& where,
+           std::shared_ptr<const PointCloud> in_map);
   static std::shared_ptr<const PointCloud> to_map_frame(const PointCloud& scan, const Pose& placed);
 
   // Planned: the next scan point for each robot (plan_fleet, PlanInput::claimed for `claimed`,
@@ -182,7 +172,6 @@ class MissionPipeline {
   std::vector<std::optional<Eigen::Vector3d>> goals_;  // per scan: Placement::goal
   std::optional<ScanGraph> graph_;
   std::optional<MapCorrection> last_correction_;
-  std::optional<std::size_t> unsettled_;  // the scan add() left for settle()
   // Per scan: how many anchored scans lay near it when it was last matched to the map; it is
   // tried again when more do.
   std::vector<std::size_t> anchored_near_;
@@ -209,9 +198,6 @@ class MissionPipeline {
   bool unsure(const Placement& where) const;
   bool beyond_reach(const MoveUncertainty& u) const;
   void follow_graph();
-  using Clock = std::chrono::steady_clock;
-  void follow(GraphUpdate& update, const std::vector<Pose>& before, Clock::time_point started,
-              bool rematch);
   void join_map(const PointCloud& own, std::size_t i);
   PointCloud own_frame(std::size_t i) const;
   bool reaches(std::size_t i, double x, double y, double radius_m) const;

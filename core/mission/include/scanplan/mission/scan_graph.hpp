@@ -106,12 +106,8 @@ class ScanGraph {
   // usually err; it ties the scan in once the odometry to the robot's next or previous scan
   // agrees (confirm_by_odometry). `scanner`: where the scanner sits in the scan's frame, for
   // telling the faces of thin surfaces apart in pairwise matches (unknown: not told apart).
-  // `with_pairs` false leaves the pairwise matches (seconds, for a scan among others the map
-  // does not hold) to add_pairs.
   GraphUpdate add(const PointCloud& scan, const Placement& where, bool tentative = false,
-                  const Viewpoints& scanner = {}, bool with_pairs = true);
-  // The pairwise matches add() left out for `scan`, and the graph optimised when there were any.
-  GraphUpdate add_pairs(std::size_t scan);
+                  const Viewpoints& scanner = {});
   // A scan not anchored so far was matched to the map after all (MapMatch::placed and
   // ::information): it is tied to the anchored scan nearest to where the match put it. Call
   // solve() after.
@@ -195,8 +191,7 @@ class ScanGraph {
   std::vector<Viewpoints> scanners_;                        // per scan, as add() was told
   std::vector<Pose> reported_;
   std::vector<std::uint8_t> anchored_;
-  std::vector<std::uint8_t> matched_to_map_;  // per scan: a believed map match placed it on add
-  std::vector<MoveUncertainty> uncertain_;    // per scan: of its estimate while not anchored
+  std::vector<MoveUncertainty> uncertain_;  // per scan: of its estimate while not anchored
   std::map<std::string, std::size_t> last_of_track_;
   std::vector<std::string> origins_;  // per edge
   std::vector<std::size_t> anchors_;  // per edge: the scan it ties into the map, or kNoNode
