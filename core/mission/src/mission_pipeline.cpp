@@ -249,12 +249,10 @@ bool MissionPipeline::rematch_refused(GraphUpdate& update) {
     if (near <= anchored_near_[u]) continue;
     anchored_near_[u] = near;
     ++update.rematches_tried;
-    const auto started = Clock::now();
     MatchViews views{{}, scanner_view()};
     const PointCloud around = points_of(sources, at.x, at.y, radius, &views.target);
     const MapMatch m = match_to_map(around, graph_->thinned(u), level(at),
                                     widened(*config_.matching, graph_->uncertainty(u)), views);
-    update.rematch_ms += ms_between(started, Clock::now());
     if (!m.applied) continue;
     if (beyond_reach(graph_->uncertainty(u)) ||
         change(at, m.placed).metres > config_.matching->max_correction_m) {

@@ -88,7 +88,6 @@ struct GraphUpdate {
   // Scans refused when they came and matched to the map again as it grew: tried, and matched
   // (tied in, or waiting for the robot's neighbouring scan to agree).
   std::size_t rematches_tried = 0, rematched = 0;
-  double rematch_ms = 0;  // those matches together (MissionPipeline makes them)
   GraphSolveReport solve;
 };
 
