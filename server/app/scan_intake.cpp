@@ -190,7 +190,6 @@ void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud, bool r
   nlohmann::json stages = {
       {"graph", t.graph}, {"map", t.map}, {"thin", t.thin}, {"plan", t.plan}, {"layers", t.layers}};
   if (match_ms) stages["match"] = *match_ms;
-  spdlog::debug("scan {}: {}", scan.id, stages.dump());
   events_.publish("map_updated", map_updated_json(scan, a, added.in_map, std::move(stages)));
 }
 

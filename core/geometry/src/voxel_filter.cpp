@@ -31,7 +31,7 @@ bool voxel_key(const Eigen::Vector3f& p, double inv, std::uint64_t& key) {
 // by key, then index. A least-significant-digit radix sort is stable, so entries of one key keep
 // their ascending indices; 8 bits a pass, passes whose digit is the same for every key skipped
 // (a scan's voxels share most of their high bits). Several times faster than a comparison sort
-// on the hundreds of thousands of points of a whole scan.
+// on the hundreds of thousands of voxels of a whole map.
 void sort_by_key(std::vector<std::pair<std::uint64_t, std::uint32_t>>& keyed) {
   std::vector<std::pair<std::uint64_t, std::uint32_t>> spare(keyed.size());
   for (int shift = 0; shift < 64; shift += 8) {
@@ -98,22 +98,21 @@ std::vector<std::pair<std::uint64_t, std::uint32_t>> representatives(const Point
   const double inv = 1.0 / voxel_m;
   VoxelNumbers numbers;
   std::vector<std::uint32_t> number_of(cloud.size(), kNone);
-  std::vector<Eigen::Vector3d> sums;
+  std::vector<Eigen::Vector3d> centroids;  // the sums until divided
   std::vector<std::uint32_t> counts;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     std::uint64_t key;
     if (!cloud.points[i].allFinite() || !voxel_key(cloud.points[i], inv, key)) continue;
     const std::uint32_t n = numbers.number(key);
-    if (n == sums.size()) {
-      sums.emplace_back(Eigen::Vector3d::Zero());
+    if (n == centroids.size()) {
+      centroids.emplace_back(Eigen::Vector3d::Zero());
       counts.push_back(0);
     }
-    sums[n] += cloud.points[i].cast<double>();
+    centroids[n] += cloud.points[i].cast<double>();
     ++counts[n];
     number_of[i] = n;
   }
-  for (std::size_t n = 0; n < sums.size(); ++n) sums[n] /= static_cast<double>(counts[n]);
-  const std::vector<Eigen::Vector3d>& centroids = sums;
+  for (std::size_t n = 0; n < centroids.size(); ++n) centroids[n] /= static_cast<double>(counts[n]);
   std::vector<std::uint32_t> nearest(centroids.size(), kNone);
   std::vector<double> nearest_sq(centroids.size(), std::numeric_limits<double>::max());
   for (std::size_t i = 0; i < cloud.size(); ++i) {

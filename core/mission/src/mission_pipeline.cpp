@@ -154,7 +154,6 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
   if (rematched) follow_graph();
   last_correction_ = correction(update, before);
   last_correction_->graph_ms = ms_between(t0, t1) + ms_between(t2, t3);
-  last_correction_->map_ms = ms_between(t1, t2) + ms_between(t3, Clock::now());
 }
 
 void MissionPipeline::join_map(const PointCloud& own, std::size_t i) {

@@ -49,9 +49,9 @@ struct MapCorrection {
   // until they add up.
   std::vector<std::size_t> moved;
   double max_moved_m = 0, max_turned_deg = 0;
-  // Where the scan's joining went (wall clock): the graph (its pairs, the refused scans matched
-  // again, the solve) and the map following it (the MLS map, segmentation, movable region).
-  double graph_ms = 0, map_ms = 0;
+  // How long the graph took over the scan (wall clock): its pairs, the refused scans matched
+  // again, the solve.
+  double graph_ms = 0;
 };
 
 // The paper's loop as one object (§3 steps 1–4 with §4's matching), used alike by the server
