@@ -8,8 +8,11 @@
 // Stage by stage (medians, from the server's event times and the page's clock): the scan's way in
 // (done → scan_received: DDS transfer, the PLY synced), matching (→ match_done), the map, regions,
 // layers and plan (→ plan_done; of which the planner's own plan_ms), the page (→ candidates
-// shown), and the scan's chunk drawn in the 3-D view (plan_done → drawn). Prints one JSON line. Usage: tests/bench/scan_to_page.sh [SCANS] [ROBOTS]
-import { readFileSync } from 'node:fs';
+// shown), and the scan's chunk drawn in the 3-D view (plan_done → drawn); beside them the
+// server's own account of each scan (map_updated's stages_ms: match, graph, map, thin, plan,
+// layers). Prints one JSON line. Usage: tests/bench/scan_to_page.sh [SCANS] [ROBOTS]; with
+// SCANPLAN_BENCH_SERVER_LOG=FILE the server's log is kept there.
+import { readFileSync, writeFileSync } from 'node:fs';
 import { requestScan, scratchDir, startStack, worldVariant } from '../support/stack.mjs';
 import { openPage, withBrowser } from '../support/browser.mjs';
 
@@ -33,7 +36,7 @@ try {
     await page.waitForFunction(() => document.body.dataset.ws === 'open', null, { timeout: 30000 });
     // In the page: the server times of each scan's end and plan, and the frame that shows it.
     await page.evaluate(() => {
-      const log = { done: {}, plan: {}, shown: {}, received: {}, matched: {}, drawn: {} }; // by robot, or by scan
+      const log = { done: {}, plan: {}, shown: {}, received: {}, matched: {}, drawn: {}, inside: {} }; // by robot, or by scan
       window.__latency = log;
       const push = (k, robot, v) => (log[k][robot] ??= []).push(v);
       const { events, candidates } = window.scanplan;
@@ -43,6 +46,7 @@ try {
         if (e.type === 'plan_done') push('plan', e.robot, { at: Date.parse(e.at), scan: e.based_on_scan, ms: e.plan_ms });
         if (e.type === 'scan_received') push('received', e.robot, { at: Date.parse(e.at), scan: e.scan });
         if (e.type === 'match_done') log.matched[e.scan] = Date.parse(e.at);
+        if (e.type === 'map_updated' && e.stages_ms) log.inside[e.scan] = e.stages_ms;
         inner(e);
       };
       const { view } = window.scanplan;
@@ -109,6 +113,8 @@ try {
   const page = [];
   const server = [];
   const stages = { way_in: [], matching: [], map_and_plan: [], of_which_planner: [], page: [], chunk_drawn_after_plan: [] };
+  // Inside the server, per scan (map_updated's stages_ms: match, graph, map, thin, plan, layers).
+  const inside = {};
   for (const [robot, ends] of Object.entries(result.done)) {
     for (const done of ends) {
       const plan = (result.plan[robot] || []).find((p) => p.at >= done);
@@ -124,6 +130,7 @@ try {
       if (Number.isFinite(plan.ms)) stages.of_which_planner.push(plan.ms);
       if (shown) stages.page.push(shown.at - plan.at);
       if (result.drawn[plan.scan]) stages.chunk_drawn_after_plan.push(result.drawn[plan.scan] - plan.at);
+      for (const [k, v] of Object.entries(result.inside[plan.scan] ?? {})) (inside[k] ??= []).push(v);
     }
   }
   console.log(JSON.stringify({
@@ -137,9 +144,11 @@ try {
     page_minus_server_ms_median: median(page) - median(server),
     server_cpu_s: serverCpuS,
     stage_ms_median: Object.fromEntries(Object.entries(stages).map(([k, v]) => [k, median(v)])),
+    server_stage_ms_median: Object.fromEntries(Object.entries(inside).map(([k, v]) => [k, median(v)])),
     page_ms: page.map(Math.round),
     at_rest: result.atRest,
   }));
 } finally {
   await stack.stop();
+  if (process.env.SCANPLAN_BENCH_SERVER_LOG) writeFileSync(process.env.SCANPLAN_BENCH_SERVER_LOG, stack.server.log);
 }

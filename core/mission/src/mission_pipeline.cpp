@@ -5,6 +5,8 @@
 #include <cmath>
 #include <utility>
 
+#include "scanplan/mission/ahead_of_turn.hpp"
+
 namespace scanplan {
 namespace {
 
@@ -233,11 +235,15 @@ bool MissionPipeline::beyond_reach(const MoveUncertainty& u) const {
 // scans with too little anchored in view).
 bool MissionPipeline::rematch_refused(GraphUpdate& update) {
   const double radius = config_.matching->target_radius_m;
-  bool any = false;
+  struct Retry {
+    std::size_t scan;
+    std::vector<std::size_t> sources;
+  };
+  std::vector<Retry> retries;
   for (std::size_t u = 0; u + 1 < placed_.size(); ++u) {  // the newest was matched just now
     if (anchored_[u]) continue;
     const Pose& at = poses_[u];
-    const std::vector<std::size_t> sources = match_sources(at.x, at.y, radius);
+    std::vector<std::size_t> sources = match_sources(at.x, at.y, radius);
     // Only places scanned anew count: a scan taken again where one was changes nothing the
     // match would see (match_sources), and retrying every refused scan near it at each pass of
     // a long mission made one scan cost seconds.
@@ -248,20 +254,33 @@ bool MissionPipeline::rematch_refused(GraphUpdate& update) {
     if (near <= anchored_near_[u]) continue;
     anchored_near_[u] = near;
     ++update.rematches_tried;
-    MatchViews views{{}, scanner_view()};
-    const PointCloud around = points_of(sources, at.x, at.y, radius, &views.target);
-    const MapMatch m = match_to_map(around, graph_->thinned(u), level(at),
-                                    widened(*config_.matching, graph_->uncertainty(u)), views);
-    if (!m.applied) continue;
-    if (beyond_reach(graph_->uncertainty(u)) ||
-        change(at, m.placed).metres > config_.matching->max_correction_m) {
-      graph_->offer_match_to_map(u, m.placed, m.information);
-    } else {
-      graph_->add_match_to_map(u, m.placed, m.information);
-    }
-    ++update.rematched;
-    any = true;
+    retries.push_back({u, std::move(sources)});
   }
+  bool any = false;
+  // A re-match believed may tie in the robot's next scan (ScanGraph::offer_match_to_map), whose
+  // own re-match then searches from its new uncertainty: matched ahead where that holds.
+  detail::match_ahead_of_turn(
+      retries.size(), config_.graph->threads,
+      [&](std::size_t r) { return graph_->uncertainty(retries[r].scan); },
+      [&](std::size_t r, const MoveUncertainty& uncertain) {
+        const Pose& at = poses_[retries[r].scan];
+        MatchViews views{{}, scanner_view()};
+        const PointCloud around = points_of(retries[r].sources, at.x, at.y, radius, &views.target);
+        return match_to_map(around, graph_->thinned(retries[r].scan), level(at),
+                            widened(*config_.matching, uncertain), views);
+      },
+      [&](std::size_t r, const MapMatch& m) {
+        const std::size_t u = retries[r].scan;
+        if (!m.applied) return;
+        if (beyond_reach(graph_->uncertainty(u)) ||
+            change(poses_[u], m.placed).metres > config_.matching->max_correction_m) {
+          graph_->offer_match_to_map(u, m.placed, m.information);
+        } else {
+          graph_->add_match_to_map(u, m.placed, m.information);
+        }
+        ++update.rematched;
+        any = true;
+      });
   if (any) update.solve = graph_->solve();
   return any;
 }

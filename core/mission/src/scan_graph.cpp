@@ -7,6 +7,7 @@
 
 #include "scanplan/geometry/pose_information.hpp"
 #include "scanplan/geometry/voxel_filter.hpp"
+#include "scanplan/mission/ahead_of_turn.hpp"
 
 namespace scanplan {
 namespace {
@@ -284,19 +285,24 @@ void ScanGraph::match_pairs(std::size_t k, bool matched_to_map, GraphUpdate& upd
   std::sort(near.begin(), near.end());
   if (near.size() > config_.max_pairs) near.resize(config_.max_pairs);
   const auto t0 = std::chrono::steady_clock::now();
-  for (const auto& [d, j] : near) {
-    ++update.pairs_tried;
-    const auto edge = match_pair(j, k);
-    if (!edge) continue;
-    ++update.pairs_matched;
-    if (anchored_[j] == anchored_[k]) {
-      // Two scans neither of which the map holds: their chain floats together until one is
-      // tied in (anchors nothing).
-      add_match_edge(*edge, "pair-search", kNoNode);
-    } else {
-      offer(*edge, anchored_[j] ? k : j);
-    }
-  }
+  // Each pair starts from the graph as the pairs before it left it (a scan tied in by two
+  // agreeing pairs is searched narrowly from there on); matched ahead where that holds.
+  detail::match_ahead_of_turn(
+      near.size(), config_.threads, [&](std::size_t n) { return pair_start(near[n].second, k); },
+      [&](std::size_t n, const PairStart& start) { return match_pair(near[n].second, k, start); },
+      [&](std::size_t n, const std::optional<GraphEdge>& edge) {
+        const std::size_t j = near[n].second;
+        ++update.pairs_tried;
+        if (!edge) return;
+        ++update.pairs_matched;
+        if (anchored_[j] == anchored_[k]) {
+          // Two scans neither of which the map holds: their chain floats together until one is
+          // tied in (anchors nothing).
+          add_match_edge(*edge, "pair-search", kNoNode);
+        } else {
+          offer(*edge, anchored_[j] ? k : j);
+        }
+      });
   update.match_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -312,15 +318,19 @@ MoveUncertainty ScanGraph::relative_uncertainty(std::size_t from, std::size_t to
   return {std::hypot(f.xy_m, t.xy_m), std::hypot(f.z_m, t.z_m), std::hypot(f.yaw_deg, t.yaw_deg)};
 }
 
-std::optional<GraphEdge> ScanGraph::match_pair(std::size_t from, std::size_t to) const {
-  const Pose a = level(graph_.pose(from));
-  const Pose b = level(graph_.pose(to));
+ScanGraph::PairStart ScanGraph::pair_start(std::size_t from, std::size_t to) const {
+  return {level(graph_.pose(from)), level(graph_.pose(to)), relative_uncertainty(from, to)};
+}
+
+std::optional<GraphEdge> ScanGraph::match_pair(std::size_t from, std::size_t to,
+                                               const PairStart& start) const {
+  const Pose& a = start.from;
+  const Pose& b = start.to;
   const Eigen::Isometry3d initial = a.isometry().inverse() * b.isometry();
   // One end is not anchored (match_pairs): where it lies may be metres off.
-  const RegistrationResult r =
-      register_scans(*thinned_[from], *thinned_[to], initial, Method::kSearchGicp,
-                     widened(config_.registration, relative_uncertainty(from, to)),
-                     {scanners_[from], scanners_[to]});
+  const RegistrationResult r = register_scans(
+      *thinned_[from], *thinned_[to], initial, Method::kSearchGicp,
+      widened(config_.registration, start.uncertainty), {scanners_[from], scanners_[to]});
   if (!r.converged) return std::nullopt;
   // How far the result is from where the graph had the pair, in `from`'s levelled frame (the
   // clouds are levelled: the transform is the relative pose itself).

@@ -13,6 +13,7 @@ struct Pose {
   Eigen::Isometry3d isometry() const;
   static Pose from_isometry(const Eigen::Isometry3d& T);
   Eigen::Quaterniond orientation() const;
+  bool operator==(const Pose&) const = default;
 };
 
 constexpr double deg2rad(double d) {

@@ -27,6 +27,10 @@ struct ScanGraphConfig {
   // time (the planner spaces scans 30–40 m).
   double pair_radius_m = 45.0;
   std::size_t max_pairs = 6;
+  // Pairwise matches and re-matches of refused scans made at once, one a thread (0: the OpenMP
+  // default, the cores). Each is tens of milliseconds of work, so a loaded core delays it
+  // without the barrier costs of a finer split; the graph is the same on any count.
+  int threads = 0;
   // The pairwise match: the search over how far off the scan not anchored may be, then GICP
   // (search-gicp), on the scans thinned and levelled, its lengths sized from how far each scan
   // sees where its view is open (RegistrationConfig::range_by_direction).
@@ -65,6 +69,7 @@ PointCloud levelled(PointCloud scan, const Pose& pose);
 // axis and of the yaw.
 struct MoveUncertainty {
   double xy_m = 0, z_m = 0, yaw_deg = 0;
+  bool operator==(const MoveUncertainty&) const = default;
 };
 
 // `config` whose search reaches 3σ of `prior` where that is wider than it already is
@@ -159,7 +164,16 @@ class ScanGraph {
  private:
   void add_odometry(std::size_t from, std::size_t to);
   void match_pairs(std::size_t scan, bool matched_to_map, GraphUpdate& update);
-  std::optional<GraphEdge> match_pair(std::size_t from, std::size_t to) const;
+  // What a pairwise match starts from: both ends levelled as the graph has them, and how far
+  // off that may be.
+  struct PairStart {
+    Pose from, to;
+    MoveUncertainty uncertainty;
+    bool operator==(const PairStart&) const = default;
+  };
+  PairStart pair_start(std::size_t from, std::size_t to) const;
+  std::optional<GraphEdge> match_pair(std::size_t from, std::size_t to,
+                                      const PairStart& start) const;
   MoveUncertainty relative_uncertainty(std::size_t from, std::size_t to) const;
   void update_anchors(const GraphSolveReport& solve);
   static constexpr std::size_t kNoNode = static_cast<std::size_t>(-1);
