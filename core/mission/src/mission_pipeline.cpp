@@ -476,10 +476,22 @@ PointCloud MissionPipeline::points_of(const std::vector<std::size_t>& scans, dou
   const Eigen::Vector2f c(static_cast<float>(x), static_cast<float>(y));
   const float r2 = static_cast<float>(radius_m * radius_m);
   const Eigen::Vector3f sensor = scanner_view().origins.front();
+  const auto within = [&](const Eigen::Vector3f& p) {
+    return (p.head<2>() - c).squaredNorm() <= r2;
+  };
+  // Counted first: millions of points on a long session, and a growing vector would copy them
+  // over and over and hold twice their memory while it does.
+  std::size_t count = 0;
+  for (const std::size_t i : scans) {
+    const auto& points = placed_[i]->points;
+    count += static_cast<std::size_t>(std::count_if(points.begin(), points.end(), within));
+  }
+  out.points.reserve(count);
+  if (views) views->origin_of.reserve(count);
   for (const std::size_t i : scans) {
     const std::size_t before = out.size();
     for (const auto& p : placed_[i]->points) {
-      if ((p.head<2>() - c).squaredNorm() <= r2) out.points.push_back(p);
+      if (within(p)) out.points.push_back(p);
     }
     if (views && out.size() > before) {
       // The scan's points are in the map frame at cloud_poses_[i]; so is its scanner.

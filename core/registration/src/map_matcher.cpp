@@ -27,6 +27,9 @@ void crop_to_level_frame(const PointCloud& map_points, const MatchViews& views, 
   std::vector<std::uint32_t> kept;
   const auto r2 = static_cast<float>(radius_m * radius_m);
   const Eigen::Vector2f center(static_cast<float>(reported.x), static_cast<float>(reported.y));
+  // Usually every point is kept (the caller gathered them around the same place).
+  target.points.reserve(map_points.size());
+  kept.reserve(map_points.size());
   for (std::size_t i = 0; i < map_points.size(); ++i) {
     const Eigen::Vector3f& p = map_points.points[i];
     if ((p.head<2>() - center).squaredNorm() <= r2) {
