@@ -41,8 +41,9 @@ void match_ahead_of_turn(std::size_t n, int threads, const StartOf& start_of, co
     std::vector<std::exception_ptr> failed(count);
     if (count > 1) {
       for (std::size_t b = 0; b < count; ++b) starts.push_back(start_of(first + b));
-#pragma omp parallel for schedule(dynamic, 1) num_threads(static_cast <int>(count))
-      for (long long b = 0; b < static_cast<long long>(count); ++b) {
+      const int team = static_cast<int>(count);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(team)
+      for (long long b = 0; b < team; ++b) {
         const auto u = static_cast<std::size_t>(b);
         try {
           ahead[u].emplace(match(first + u, starts[u]));
