@@ -114,7 +114,7 @@ TEST(LoopClosure, TheGraphIsTheSameOnAnyThreadCount) {
   const Drive one = drive_loop(true, 1, 5);
   ASSERT_GE(one.pairs, 4u);
   RecordProperty("pairs", std::to_string(one.pairs));
-  // Four at a time: a scan tied in by an early pair of a batch changes where the later ones start.
+  // Four at a time as well (a result whose start an earlier one moved: AheadOfTurn's tests).
   for (const int threads : {2, 4}) {
     const Drive many = drive_loop(true, threads, 5);
     EXPECT_EQ(many.pairs, one.pairs) << threads << " threads";
