@@ -63,6 +63,10 @@ void PoseGraph::set_pose(std::size_t node, const Pose& estimate) {
   poses_.at(node) = estimate;
 }
 
+void PoseGraph::set_measured(std::size_t edge, const RelativePose& measured) {
+  edges_.at(edge).measured = measured;
+}
+
 void PoseGraph::add_edge(const GraphEdge& edge) {
   if (edge.from >= poses_.size() || edge.to >= poses_.size()) {
     throw std::invalid_argument("pose graph edge " + std::to_string(edge.from) + " → " +

@@ -142,6 +142,7 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
   const std::vector<Pose> before = poses_;
   const auto t0 = Clock::now();
   const std::optional<SensorFix> fix = where.matched ? std::nullopt : sensors_place(where);
+  if (config_.pose_noise.model == OdometryModel::kAbsolute) graph_->set_sensor_frame(sensor_frame_);
   GraphUpdate update = graph_->add(scan, where, where.matched && unsure(where), scanner_view());
   const std::size_t k = placed_.size() - 1;
   if (fix && !graph_->anchored(k)) {

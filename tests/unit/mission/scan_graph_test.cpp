@@ -134,5 +134,54 @@ TEST(ScanGraph, AWaitingMatchKeepsItsPlaceRelativeToTheMapItWasMatchedTo) {
   EXPECT_NEAR(graph.poses()[2].x - graph.poses()[1].x, 50.0, 0.05);
 }
 
+// An absolute fix places a scan no match placed where the sensors' frame, as the anchored scans
+// measure it, carries the fix: not where the move from the robot's previous fix points, which
+// that fix's heading error swings sideways (15° over 140 m: 37 m).
+TEST(ScanGraph, AScanNoMatchPlacedLiesAtItsFixInTheMapFrame) {
+  const PoseNoise fixes;  // absolute, σ 1 m, 5°
+  ScanGraph graph({}, fixes);
+  SensorFrame frame(fixes);
+  const auto scan = [&](const Pose& reported, const Pose& placed, bool matched) {
+    if (matched) frame.add(reported, placed);
+    Placement where = placement(reported, placed, matched);
+    // Per point, as a campus map match gives it (weakest across a street): the match edges
+    // are far surer than any fix.
+    if (matched) where.information = Eigen::Vector4d(0.06, 0.77, 0.16, 262).asDiagonal();
+    graph.set_sensor_frame(frame);
+    graph.add(few_points(), where);
+  };
+  scan(at(0, 0, 0), at(0, 0, 0), false);
+  frame.add(at(0, 0, 0), at(0, 0, 0));
+  scan(at(30, 1, 15), at(30, 0, 0), true);  // a fix 1 m and 15° off, matched
+  scan(at(100, 50, 0), at(99.5, 50.5, 2), true);
+  const Pose reported = at(170, 100, 0);
+  const Pose fix = frame.to_map(reported);
+  scan(reported, fix, false);
+  ASSERT_FALSE(graph.anchored(3));
+  const Pose& placed = graph.poses()[3];
+  EXPECT_NEAR(placed.x, fix.x, 0.01);
+  EXPECT_NEAR(placed.y, fix.y, 0.01);
+  EXPECT_NEAR(placed.yaw, fix.yaw, 1e-4);
+  EXPECT_EQ(graph.edge_origin(graph.graph().edges().size() - 1), "fix");
+  // Carried from the previous fix it would lie metres away: the test tells the two apart.
+  const Pose chained =
+      compose(graph.poses()[2], relative_pose(at(100, 50, 0), reported), placed.roll, placed.pitch);
+  EXPECT_GT(std::hypot(chained.x - fix.x, chained.y - fix.y), 2.0);
+
+  // The matched scans stay where their matches put them, their fixes metres off notwithstanding.
+  EXPECT_NEAR(graph.poses()[1].x, 30, 0.01);
+  EXPECT_NEAR(graph.poses()[1].y, 0, 0.01);
+  EXPECT_NEAR(rad2deg(graph.poses()[1].yaw), 0, 0.01);
+
+  // The frame measured anew (one more anchored scan): the unmatched scan follows it.
+  frame.add(at(60, 80, -3), at(61, 80.5, 0));
+  graph.set_sensor_frame(frame);
+  graph.solve();
+  const Pose refit = frame.to_map(reported);
+  ASSERT_GT(std::hypot(refit.x - fix.x, refit.y - fix.y), 0.1);
+  EXPECT_NEAR(graph.poses()[3].x, refit.x, 0.01);
+  EXPECT_NEAR(graph.poses()[3].y, refit.y, 0.01);
+}
+
 }  // namespace
 }  // namespace scanplan

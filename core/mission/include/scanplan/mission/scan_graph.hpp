@@ -11,6 +11,7 @@
 #include "scanplan/geometry/pose_noise.hpp"
 #include "scanplan/graph/pose_graph.hpp"
 #include "scanplan/mission/placement.hpp"
+#include "scanplan/mission/sensor_frame.hpp"
 #include "scanplan/registration/registration.hpp"
 
 namespace scanplan {
@@ -97,10 +98,11 @@ struct GraphUpdate {
 };
 
 // The scans of a mission as a pose graph (issue 17): the robot's odometry between its
-// consecutive scans, each believed scan-to-map match, and pairwise matches between every two
-// scans near each other (so a scan that could not be matched when it came is tied in by later
-// ones, and a robot coming back near old scans closes the loop), optimised after every scan.
-// Keeps each scan thinned and levelled for the pairwise matches. Not thread-safe.
+// consecutive scans (or, for absolute fixes, each scan's fix in the map frame), each believed
+// scan-to-map match, and pairwise matches between every two scans near each other (so a scan that
+// could not be matched when it came is tied in by later ones, and a robot coming back near old
+// scans closes the loop), optimised after every scan. Keeps each scan thinned and levelled for the
+// pairwise matches. Not thread-safe.
 class ScanGraph {
  public:
   ScanGraph(ScanGraphConfig config, PoseNoise noise);
@@ -128,6 +130,11 @@ class ScanGraph {
   // scan for a short drive on odometry) by what the sensors reported, with their information.
   // Call solve() after.
   void anchor_by_sensors(std::size_t scan, std::size_t from, const Eigen::Matrix4d& information);
+  // Absolute fixes (OdometryModel::kAbsolute): where the pose sensors' frame lies in the map
+  // frame, as the anchored scans now measure it (MissionPipeline's SensorFrame). Every scan's
+  // fix edge is carried into the map frame by it, the next scan's too. Call solve() after (or
+  // add()).
+  void set_sensor_frame(const SensorFrame& frame);
   GraphSolveReport solve();
 
   std::size_t size() const { return graph_.size(); }
@@ -154,15 +161,18 @@ class ScanGraph {
   // does).
   const MoveUncertainty& uncertainty(std::size_t scan) const { return uncertain_.at(scan); }
   const PoseGraph& graph() const { return graph_; }
-  // How each edge of graph() came about, by index: "odometry", "pair-search" (a pairwise match,
-  // the search first: one end was not anchored), "map" (a scan-to-map match when the scan came),
-  // "map-confirmed" (one beyond the sensors' reach, confirmed by the odometry to the robot's
-  // next or previous scan), "rematch" (one later), "sensors" (anchor_by_sensors).
+  // How each edge of graph() came about, by index: "odometry", "fix" (an absolute fix),
+  // "pair-search" (a pairwise match, the search first: one end was not anchored), "map" (a
+  // scan-to-map match when the scan came), "map-confirmed" (one beyond the sensors' reach,
+  // confirmed by the odometry to the robot's next or previous scan), "rematch" (one later),
+  // "sensors" (anchor_by_sensors).
   const std::string& edge_origin(std::size_t edge) const { return origins_.at(edge); }
   const ScanGraphConfig& config() const { return config_; }
 
  private:
   void add_odometry(std::size_t from, std::size_t to);
+  void add_fix(std::size_t scan);
+  RelativePose fix_from_first(std::size_t scan) const;
   void match_pairs(std::size_t scan, bool matched_to_map, GraphUpdate& update);
   // What a pairwise match starts from: both ends levelled as the graph has them, and how far
   // off that may be.
@@ -212,8 +222,10 @@ class ScanGraph {
   std::vector<std::vector<GraphEdge>> pending_;
   // Per scan: a map match beyond the sensors' usual reach, waiting for the odometry to agree.
   std::vector<std::optional<MapCandidate>> pending_map_;
-  std::vector<std::size_t> previous_;  // per scan: the robot's scan before it, or kNoNode
-  std::vector<std::string> tracks_;    // per scan
+  std::vector<std::size_t> previous_;   // per scan: the robot's scan before it, or kNoNode
+  std::vector<std::string> tracks_;     // per scan
+  SensorFrame frame_;                   // absolute fixes: the sensors' frame in the map frame
+  std::vector<std::size_t> fix_edges_;  // absolute fixes: the fix edge of scan 1, 2, …
 };
 
 }  // namespace scanplan
