@@ -12,6 +12,15 @@
 namespace scanplan {
 namespace {
 
+void check_information(const GraphEdge& edge, const Eigen::Matrix4d& info) {
+  if (!info.allFinite() || !info.isApprox(info.transpose(), 1e-9) ||
+      Eigen::LLT<Eigen::Matrix4d>(info).info() != Eigen::Success) {
+    throw std::invalid_argument("pose graph edge " + std::to_string(edge.from) + " → " +
+                                std::to_string(edge.to) +
+                                ": information matrix not symmetric positive definite");
+  }
+}
+
 template <typename T>
 T wrapped_angle(const T& a) {
   // atan2 of the angle's own sine and cosine: smooth for the automatic derivatives, unlike
@@ -63,10 +72,6 @@ void PoseGraph::set_pose(std::size_t node, const Pose& estimate) {
   poses_.at(node) = estimate;
 }
 
-void PoseGraph::set_measured(std::size_t edge, const RelativePose& measured) {
-  edges_.at(edge).measured = measured;
-}
-
 void PoseGraph::add_edge(const GraphEdge& edge) {
   if (edge.from >= poses_.size() || edge.to >= poses_.size()) {
     throw std::invalid_argument("pose graph edge " + std::to_string(edge.from) + " → " +
@@ -74,14 +79,16 @@ void PoseGraph::add_edge(const GraphEdge& edge) {
                                 std::to_string(poses_.size()) + " scans)");
   }
   if (edge.from == edge.to) throw std::invalid_argument("pose graph edge from a scan to itself");
-  const Eigen::Matrix4d& info = edge.information;
-  if (!info.allFinite() || !info.isApprox(info.transpose(), 1e-9) ||
-      Eigen::LLT<Eigen::Matrix4d>(info).info() != Eigen::Success) {
-    throw std::invalid_argument("pose graph edge " + std::to_string(edge.from) + " → " +
-                                std::to_string(edge.to) +
-                                ": information matrix not symmetric positive definite");
-  }
+  check_information(edge, edge.information);
   edges_.push_back(edge);
+}
+
+void PoseGraph::set_measurement(std::size_t edge, const RelativePose& measured,
+                                const Eigen::Matrix4d& information) {
+  GraphEdge& e = edges_.at(edge);
+  check_information(e, information);
+  e.measured = measured;
+  e.information = information;
 }
 
 double PoseGraph::whitened_error(std::size_t edge) const {

@@ -235,26 +235,31 @@ void ScanGraph::add_odometry(std::size_t from, std::size_t to) {
 // error swings it sideways by its length: a scan no match placed ended 22–37 m from the truth
 // after a 147 m move from a fix 15° off (3σ), and a re-match started there could not find it
 // (issue 15). Carried into the map frame by the frame the anchored scans measure, the fix is off
-// by about one scan's sensor error, however far the robot drove.
+// by about one scan's sensor error, however far the robot drove (SensorFrame::spread).
 void ScanGraph::add_fix(std::size_t k) {
-  // Two independent errors: this fix's and the frame's, measured from the others.
-  const MoveUncertainty u = odometry_uncertainty({});
-  graph_.add_edge({0, k, fix_from_first(k), diagonal_information(u.xy_m, u.z_m, deg2rad(u.yaw_deg)),
-                   EdgeKind::kOdometry});
+  const auto [measured, information] = fix_of(k);
+  graph_.add_edge({0, k, measured, information, EdgeKind::kOdometry});
   fix_edges_.push_back(graph_.edges().size() - 1);
   origins_.emplace_back("fix");
   anchors_.push_back(kNoNode);
 }
 
-// The fix of scan `k` (k > 0) seen from the first scan, which is the map frame's and held fixed.
-RelativePose ScanGraph::fix_from_first(std::size_t k) const {
-  return relative_pose(graph_.pose(0), frame_.to_map(reported_[k]));
+// The fix of scan `k` (k > 0) seen from the first scan, which is the map frame's and held fixed,
+// and how sure it is.
+std::pair<RelativePose, Eigen::Matrix4d> ScanGraph::fix_of(std::size_t k) const {
+  const MoveUncertainty u = frame_.spread(reported_[k]);
+  const double xy = std::max(u.xy_m, config_.min_odometry_sigma_m);
+  const double z = std::max(u.z_m, config_.min_odometry_sigma_m);
+  const double yaw = deg2rad(std::max(u.yaw_deg, config_.min_odometry_sigma_deg));
+  return {relative_pose(graph_.pose(0), frame_.to_map(reported_[k])),
+          diagonal_information(xy, z, yaw)};
 }
 
 void ScanGraph::set_sensor_frame(const SensorFrame& frame) {
   frame_ = frame;
   for (std::size_t i = 0; i < fix_edges_.size(); ++i) {
-    graph_.set_measured(fix_edges_[i], fix_from_first(i + 1));
+    const auto [measured, information] = fix_of(i + 1);
+    graph_.set_measurement(fix_edges_[i], measured, information);
   }
 }
 

@@ -1,12 +1,18 @@
 #include "scanplan/mission/sensor_frame.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 namespace scanplan {
 namespace {
+
+// σ never below these in the fit's covariance: exact sensors leave it otherwise singular.
+constexpr double kFloorM = 1e-3;
+constexpr double kFloorDeg = 1e-3;
 
 double wrapped(double a) {
   return std::remainder(a, 2 * M_PI);
@@ -71,6 +77,43 @@ void SensorFrame::refit() {
   double dz = 0;
   for (std::size_t i = 0; i < n; ++i) dz += placed_[i].z - reported_[i].z;
   tz_ = dz / static_cast<double>(n);
+
+  // The fit's covariance, linearised at its optimum: each position turns with θ about the sensor
+  // frame's origin and moves with t; each yaw reading measures θ. Sure sensors still leave the
+  // 3 × 3 system invertible through the floors.
+  const double xy2 = std::pow(std::max(noise_.xy_sigma_m, kFloorM), 2);
+  const double yaw2 = std::pow(std::max(sigma_yaw, deg2rad(kFloorDeg)), 2);
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    Eigen::Matrix<double, 2, 3> J;
+    J.col(0) = turned(reported_[i]);
+    J.rightCols<2>().setIdentity();
+    information += J.transpose() * J / xy2;
+    information(0, 0) += 1 / yaw2;
+  }
+  covariance_ = information.inverse();
+}
+
+// d(R(θ)·r)/dθ at the fitted θ.
+Eigen::Vector2d SensorFrame::turned(const Pose& reported) const {
+  const double c = std::cos(yaw_), s = std::sin(yaw_);
+  return {-s * reported.x - c * reported.y, c * reported.x - s * reported.y};
+}
+
+MoveUncertainty SensorFrame::spread(const Pose& reported) const {
+  MoveUncertainty own{noise_.xy_sigma_m, noise_.z_sigma_m, noise_.yaw_sigma_deg};
+  if (reported_.empty()) return own;
+  Eigen::Matrix<double, 2, 3> J;
+  J.col(0) = turned(reported);
+  J.rightCols<2>().setIdentity();
+  const Eigen::Matrix2d position = J * covariance_ * J.transpose();
+  // Per axis as the matcher takes it: the frame's worse direction.
+  const double frame_xy2 =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(position).eigenvalues()(1);
+  const double n = static_cast<double>(reported_.size());
+  return {
+      std::sqrt(own.xy_m * own.xy_m + std::max(frame_xy2, 0.0)), own.z_m * std::sqrt(1 + 1 / n),
+      std::sqrt(own.yaw_deg * own.yaw_deg + std::pow(rad2deg(std::sqrt(covariance_(0, 0))), 2))};
 }
 
 Pose SensorFrame::to_map(const Pose& reported) const {

@@ -3,6 +3,7 @@
 // scan's sensor error, however far from the first scan.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <random>
 
@@ -65,6 +66,59 @@ TEST(SensorFrame, ScansSpreadOverTheSiteFixTheTurnFarBetterThanOneYawReading) {
   const Pose want = in_map(far);
   EXPECT_LT(std::hypot(got.x - want.x, got.y - want.y), 2.0);
   EXPECT_LT(std::abs(rad2deg(std::remainder(got.yaw - want.yaw, 2 * M_PI))), 1.0);
+}
+
+// How far off a fix carried into the map frame may be: its own error, and the frame's as the
+// anchored scans measure it, which grows with the distance from them (the frame's turn).
+TEST(SensorFrame, AFixIsAsUnsureAsTheFrameTheAnchorsLeaveIt) {
+  const PoseNoise noise;  // σ 1 m, 0.3 m, 5°
+  const MoveUncertainty own = SensorFrame(noise).spread(at(100, 0, 0));
+  EXPECT_DOUBLE_EQ(own.xy_m, 1.0);
+  EXPECT_DOUBLE_EQ(own.yaw_deg, 5.0);
+
+  // One anchor: the frame is as wrong as its one fix, whose heading swings a scan 100 m away.
+  SensorFrame one(noise);
+  one.add(at(0, 0, 0), at(0, 0, 0));
+  const MoveUncertainty far = one.spread(at(100, 0, 0));
+  EXPECT_NEAR(far.xy_m, std::sqrt(1 + 1 + std::pow(100 * deg2rad(5), 2)), 0.01);
+  EXPECT_NEAR(far.yaw_deg, 5 * std::sqrt(2.0), 0.01);
+  EXPECT_NEAR(one.spread(at(0, 0, 0)).xy_m, std::sqrt(2.0), 0.01);
+
+  // Anchors spread over the site: the spread is what the fit's scatter really is. Over many
+  // draws of the anchors' sensor errors, the frame's error at a scan 150 m out (reported
+  // exactly, so only the frame errs) has the variance the spread predicts beyond the fix's own.
+  const double sites[][2] = {{0, 0}, {40, 5}, {80, -10}, {60, 50}, {10, 60}};
+  const Pose target = at(150, 100, 45);
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> n(0, 1);
+  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+  double yaw_scatter = 0, predicted_xy2 = 0, predicted_yaw2 = 0;
+  const int draws = 300;
+  for (int d = 0; d < draws; ++d) {
+    SensorFrame frame(noise);
+    for (const auto& xy : sites) {
+      const Pose truth = at(xy[0], xy[1], 0);
+      Pose reported = truth;
+      reported.x += n(rng);
+      reported.y += n(rng);
+      reported.yaw += deg2rad(5 * n(rng));
+      frame.add(reported, in_map(truth));
+    }
+    const Pose got = frame.to_map(target), want = in_map(target);
+    const Eigen::Vector2d e(got.x - want.x, got.y - want.y);
+    scatter += e * e.transpose() / draws;
+    yaw_scatter += std::pow(rad2deg(std::remainder(got.yaw - want.yaw, 2 * M_PI)), 2) / draws;
+    const MoveUncertainty u = frame.spread(target);
+    predicted_xy2 += (u.xy_m * u.xy_m - 1) / draws;
+    predicted_yaw2 += (u.yaw_deg * u.yaw_deg - 25) / draws;
+  }
+  const double seen_xy2 = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(scatter).eigenvalues()(1);
+  EXPECT_GT(predicted_xy2, 0.7 * seen_xy2);
+  EXPECT_LT(predicted_xy2, 1.4 * seen_xy2);
+  EXPECT_GT(predicted_yaw2, 0.7 * yaw_scatter);
+  EXPECT_LT(predicted_yaw2, 1.4 * yaw_scatter);
+  // Far better than one anchor's swing, worse than beside the anchors.
+  EXPECT_LT(std::sqrt(predicted_xy2), 3.0);
 }
 
 }  // namespace

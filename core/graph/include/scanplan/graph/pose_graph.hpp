@@ -58,8 +58,10 @@ class PoseGraph {
   void add_edge(const GraphEdge& edge);
   // Sets one node's estimate (e.g. a better start before the next solve).
   void set_pose(std::size_t node, const Pose& estimate);
-  // Sets what an edge measured (e.g. an absolute fix carried into a frame estimated anew).
-  void set_measured(std::size_t edge, const RelativePose& measured);
+  // Sets what an edge measured and how surely (e.g. an absolute fix carried into a frame
+  // estimated anew); throws as add_edge does.
+  void set_measurement(std::size_t edge, const RelativePose& measured,
+                       const Eigen::Matrix4d& information);
 
   // Moves every node but the first to the poses that best agree with all edges.
   GraphSolveReport optimise();

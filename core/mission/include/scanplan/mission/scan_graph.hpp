@@ -5,11 +5,13 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "scanplan/geometry/point_cloud.hpp"
 #include "scanplan/geometry/pose_noise.hpp"
 #include "scanplan/graph/pose_graph.hpp"
+#include "scanplan/mission/move_uncertainty.hpp"
 #include "scanplan/mission/placement.hpp"
 #include "scanplan/mission/sensor_frame.hpp"
 #include "scanplan/registration/registration.hpp"
@@ -65,13 +67,6 @@ Pose level(Pose pose);
 // (relative_pose) as it stands. Matched in their tilted own frames, two scans on sloping
 // ground turn about a tilted axis and their relative yaw comes out biased.
 PointCloud levelled(PointCloud scan, const Pose& pose);
-
-// How far off a pose carried by odometry from the robot's previous scan can be: σ of each x-y
-// axis and of the yaw.
-struct MoveUncertainty {
-  double xy_m = 0, z_m = 0, yaw_deg = 0;
-  bool operator==(const MoveUncertainty&) const = default;
-};
 
 // `config` whose search reaches 3σ of `prior` where that is wider than it already is
 // (scan-to-map matching and the pairwise search alike): a robot that drove 150 m on 2 %
@@ -172,7 +167,7 @@ class ScanGraph {
  private:
   void add_odometry(std::size_t from, std::size_t to);
   void add_fix(std::size_t scan);
-  RelativePose fix_from_first(std::size_t scan) const;
+  std::pair<RelativePose, Eigen::Matrix4d> fix_of(std::size_t scan) const;
   void match_pairs(std::size_t scan, bool matched_to_map, GraphUpdate& update);
   // What a pairwise match starts from: both ends levelled as the graph has them, and how far
   // off that may be.

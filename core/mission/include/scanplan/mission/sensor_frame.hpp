@@ -1,9 +1,11 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <vector>
 
 #include "scanplan/geometry/pose.hpp"
 #include "scanplan/geometry/pose_noise.hpp"
+#include "scanplan/mission/move_uncertainty.hpp"
 
 namespace scanplan {
 
@@ -28,13 +30,20 @@ class SensorFrame {
   // `reported` carried into the map frame (roll and pitch as they are: the inclination sensor
   // measures them against gravity, which both frames share). `reported` itself before any add.
   Pose to_map(const Pose& reported) const;
+  // How far off to_map(reported) may be: the fix's own error and the frame's, which the anchored
+  // scans measure the better the more of them there are and the farther apart they lie (with
+  // one, a scan 100 m from it is off by that one's 5° of heading: 8.7 m). The fix's own error
+  // alone before any add.
+  MoveUncertainty spread(const Pose& reported) const;
 
  private:
   void refit();
+  Eigen::Vector2d turned(const Pose& reported) const;
 
   PoseNoise noise_;
   std::vector<Pose> reported_, placed_;
-  double yaw_ = 0, tx_ = 0, ty_ = 0, tz_ = 0;  // map_from_sensor
+  double yaw_ = 0, tx_ = 0, ty_ = 0, tz_ = 0;             // map_from_sensor
+  Eigen::Matrix3d covariance_ = Eigen::Matrix3d::Zero();  // of (yaw_, tx_, ty_)
 };
 
 }  // namespace scanplan
