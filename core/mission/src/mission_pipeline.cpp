@@ -90,13 +90,6 @@ std::optional<MissionPipeline::MatchInput> MissionPipeline::match_input(
   if (graph_) {
     if (const auto prior = graph_->prior_uncertainty(track, reported)) {
       config = widened(config, *prior);
-    } else if (config_.pose_noise.model == OdometryModel::kAbsolute) {
-      // Of two fits, the one nearer the fix comes first, and one beyond its 99 % ellipsoid is a
-      // look-alike (match_to_map): on a long facade the search's best peaks at coarse
-      // resolution lay 15–20 m along it, and GICP from them settled nowhere.
-      const MoveUncertainty fix = sensor_frame_.spread(reported);
-      config.registration.search.prior_sigma_xy_m = fix.xy_m;
-      config.registration.search.prior_sigma_yaw_deg = fix.yaw_deg;
     }
   }
   MatchInput in{{}, config, start, {{}, scanner_view()}};
