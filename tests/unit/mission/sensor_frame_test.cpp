@@ -27,6 +27,23 @@ Pose in_map(const Pose& sensor) {
   return p;
 }
 
+// Five scans spread over the site, each reported wrong by the sensors' σ (1 m, 5°), placed at
+// the truth by the map.
+SensorFrame anchored_over_the_site(std::mt19937_64& rng, const PoseNoise& noise) {
+  std::normal_distribution<double> n(0, 1);
+  SensorFrame frame(noise);
+  const double sites[][2] = {{0, 0}, {40, 5}, {80, -10}, {60, 50}, {10, 60}};
+  for (const auto& xy : sites) {
+    const Pose truth = at(xy[0], xy[1], 0);
+    Pose reported = truth;
+    reported.x += n(rng);
+    reported.y += n(rng);
+    reported.yaw += deg2rad(5 * n(rng));
+    frame.add(reported, in_map(truth));
+  }
+  return frame;
+}
+
 TEST(SensorFrame, WithoutAnchorsAReportedPoseIsTakenAsItIs) {
   const SensorFrame frame;
   const Pose p = frame.to_map(at(10, 20, 30));
@@ -47,19 +64,8 @@ TEST(SensorFrame, OneAnchorCarriesItsOwnPoseExactly) {
 }
 
 TEST(SensorFrame, ScansSpreadOverTheSiteFixTheTurnFarBetterThanOneYawReading) {
-  // Each anchor's report is wrong by the sensors' σ (1 m, 5°); the map knows the truth.
   std::mt19937_64 rng(3);
-  std::normal_distribution<double> n(0, 1);
-  SensorFrame frame;
-  const double sites[][2] = {{0, 0}, {40, 5}, {80, -10}, {60, 50}, {10, 60}};
-  for (const auto& xy : sites) {
-    const Pose truth = at(xy[0], xy[1], 0);
-    Pose reported = truth;
-    reported.x += n(rng);
-    reported.y += n(rng);
-    reported.yaw += deg2rad(5 * n(rng));
-    frame.add(reported, in_map(truth));
-  }
+  const SensorFrame frame = anchored_over_the_site(rng, PoseNoise{});
   // A scan 150 m out, reported exactly: 5° of frame error would put it 13 m off.
   const Pose far = at(150, 100, 45);
   const Pose got = frame.to_map(far);
@@ -87,23 +93,13 @@ TEST(SensorFrame, AFixIsAsUnsureAsTheFrameTheAnchorsLeaveIt) {
   // Anchors spread over the site: the spread is what the fit's scatter really is. Over many
   // draws of the anchors' sensor errors, the frame's error at a scan 150 m out (reported
   // exactly, so only the frame errs) has the variance the spread predicts beyond the fix's own.
-  const double sites[][2] = {{0, 0}, {40, 5}, {80, -10}, {60, 50}, {10, 60}};
   const Pose target = at(150, 100, 45);
   std::mt19937_64 rng(11);
-  std::normal_distribution<double> n(0, 1);
   Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
   double yaw_scatter = 0, predicted_xy2 = 0, predicted_yaw2 = 0;
   const int draws = 300;
   for (int d = 0; d < draws; ++d) {
-    SensorFrame frame(noise);
-    for (const auto& xy : sites) {
-      const Pose truth = at(xy[0], xy[1], 0);
-      Pose reported = truth;
-      reported.x += n(rng);
-      reported.y += n(rng);
-      reported.yaw += deg2rad(5 * n(rng));
-      frame.add(reported, in_map(truth));
-    }
+    const SensorFrame frame = anchored_over_the_site(rng, noise);
     const Pose got = frame.to_map(target), want = in_map(target);
     const Eigen::Vector2d e(got.x - want.x, got.y - want.y);
     scatter += e * e.transpose() / draws;
