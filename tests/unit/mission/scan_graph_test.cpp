@@ -136,7 +136,7 @@ TEST(ScanGraph, AWaitingMatchKeepsItsPlaceRelativeToTheMapItWasMatchedTo) {
 
 // An absolute fix places a scan no match placed where the sensors' frame, as the anchored scans
 // measure it, carries the fix: not where the move from the robot's previous fix points, which
-// that fix's heading error swings sideways (15° over 140 m: 37 m).
+// that fix's heading error swings sideways (on the campus 15° over 147 m: 37 m).
 TEST(ScanGraph, AScanNoMatchPlacedLiesAtItsFixInTheMapFrame) {
   const PoseNoise fixes;  // absolute, σ 1 m, 5°
   ScanGraph graph({}, fixes);
