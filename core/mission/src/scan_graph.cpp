@@ -71,8 +71,9 @@ MoveUncertainty ScanGraph::odometry_uncertainty(const RelativePose& move) const 
   }
   // Two independent fixes: the difference has twice their variance, and the move is measured
   // in the first one's frame, whose heading error swings it sideways by its length (on the
-  // campus, moves of 60–100 m with σ 5° were 5–17 m off: weighted as 1.4 m, they pulled the
-  // matched scans centimetres apart).
+  // campus, moves of 60–100 m with σ 5° were 5–17 m off). Only where two consecutive fixes are
+  // compared (a pair's search, whether two far corrections agree): the graph ties each fix to
+  // the map frame itself (add_fix).
   const double xy = std::max(noise_.xy_sigma_m, config_.min_odometry_sigma_m);
   const double yaw = std::max(noise_.yaw_sigma_deg, config_.min_odometry_sigma_deg);
   const double swing = std::hypot(move.x, move.y) * deg2rad(yaw);
