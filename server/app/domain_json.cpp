@@ -21,6 +21,7 @@ json progress_json(const MissionProgress& p) {
   json j = {{"state", p.state},
             {"coverage_pct", p.coverage_pct},
             {"best_gain_m2", p.best_gain_m2},
+            {"best_left_m2", p.best_left_m2},
             {"threshold_m2", p.threshold_m2},
             {"scans_left", p.scans_left ? json(*p.scans_left) : json(nullptr)}};
   if (p.state == "finished") {
@@ -118,6 +119,7 @@ json plan_header_json(const PlanRecord& p) {
           {"policy", p.policy},
           {"alpha", p.alpha},
           {"plan_ms", p.plan_ms},
+          {"best_gain_m2", p.best_gain_m2},
           {"candidates", p.candidates.size()}};
 }
 

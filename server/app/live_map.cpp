@@ -315,6 +315,7 @@ std::vector<PlanRecord> LiveMap::make_plans() const {
     record.policy = std::string(policy_name(planner.policy));
     record.alpha = planner.alpha;
     record.plan_ms = plan.plan_ms;
+    record.best_gain_m2 = plan.best_gain_m2;
     records.push_back(std::move(record));
   }
   // The robot whose scan came last is the one waiting for a decision: its plan goes last, the

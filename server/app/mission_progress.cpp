@@ -16,13 +16,19 @@ MissionProgress mission_progress(const MapAreas& now, const std::vector<MapAreas
   // A move under way counts as a suggestion still to be scanned.
   bool moving = false;
   for (const PlanRecord& plan : plans) {
+    bool open = false;
     for (const CandidateRecord& c : plan.candidates) {
       moving = moving || c.state == CandidateState::kMoving;
       if ((!is_open(c.state) && c.state != CandidateState::kMoving) || c.custom) continue;
+      open = true;
       p.best_gain_m2 =
           std::max(p.best_gain_m2, c.candidate.gain_unscanned_m2 + c.candidate.gain_low_res_m2);
     }
+    // Places the plan ranked behind count while the robot can still go on: a plan whose every
+    // suggestion was refused leads nowhere.
+    if (open) p.best_left_m2 = std::max(p.best_left_m2, plan.best_gain_m2);
   }
+  p.best_left_m2 = std::max(p.best_left_m2, p.best_gain_m2);
   if (finished) {
     p.state = "finished";
     p.finished_by = finished->first;
@@ -33,7 +39,7 @@ MissionProgress mission_progress(const MapAreas& now, const std::vector<MapAreas
     p.state = "running";
     return p;
   }
-  if (p.best_gain_m2 < p.threshold_m2 && !moving) {
+  if (p.best_left_m2 < p.threshold_m2 && !moving) {
     p.state = "complete";
     p.scans_left = 0;
     return p;
@@ -53,7 +59,7 @@ MissionProgress mission_progress(const MapAreas& now, const std::vector<MapAreas
   const double ratio = std::pow(last / first, 1.0 / static_cast<double>(k - 1));
   if (!(ratio < 0.98)) return p;
   const double decline = std::max(ratio, 0.5);
-  p.scans_left = std::max(1, static_cast<int>(std::ceil(std::log(p.threshold_m2 / p.best_gain_m2) /
+  p.scans_left = std::max(1, static_cast<int>(std::ceil(std::log(p.threshold_m2 / p.best_left_m2) /
                                                         std::log(decline))));
   return p;
 }

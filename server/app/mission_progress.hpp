@@ -13,8 +13,9 @@
 namespace scanplan::server {
 
 struct ProgressConfig {
-  // Complete when no candidate of any robot would add more than this share of the target
-  // region (unscanned or low-resolution ground it would complete), and never less than
+  // Complete when no candidate of any robot, nor any place its plan looked at, would add more
+  // than this share of the target region (unscanned or low-resolution ground it would
+  // complete), and never less than
   // min_gain_m2: a scan for a few square metres is not worth a rescue robot's minute.
   double complete_share = 0.005;
   double min_gain_m2 = 50.0;
@@ -23,9 +24,12 @@ struct ProgressConfig {
 };
 
 struct MissionProgress {
-  std::string state;                     // "running", "complete" or "finished"
-  double coverage_pct = 0;               // scan-completed share of the target region
-  double best_gain_m2 = 0;               // what the best suggested scan would add
+  std::string state;        // "running", "complete" or "finished"
+  double coverage_pct = 0;  // scan-completed share of the target region
+  double best_gain_m2 = 0;  // what the best suggested scan would add
+  // What the best place any open plan looked at would add, suggested or not (Plan::best_gain_m2:
+  // a place the matcher could not yet place a scan at is ranked behind, not done).
+  double best_left_m2 = 0;
   double threshold_m2 = 0;               // below this a scan is not worth making
   std::optional<int> scans_left;         // while running, when the gains so far allow an estimate
   std::string finished_by, finished_at;  // "finished": who and when

@@ -32,6 +32,7 @@ struct PlanRecord {
   double alpha = 0;
   double plan_ms = 0;
   std::vector<CandidateRecord> candidates;
+  double best_gain_m2 = 0;  // Plan::best_gain_m2
 };
 
 // The heading a robot takes at candidate `c`: along the last leg of its path, so the scan starts

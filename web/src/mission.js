@@ -270,7 +270,7 @@ export class MissionPanel {
       const when = Number.isNaN(at.getTime()) ? '' : ` at ${at.toLocaleTimeString('en-GB', { hour12: false })}`;
       progressLine.textContent = `mission finished by ${p.finished_by}${when} · ${p.coverage_pct.toFixed(0)} % of the area scanned`;
     } else if (p.state === 'complete') {
-      progressLine.textContent = `mission complete: ${p.coverage_pct.toFixed(0)} % of the area scanned; no suggested point adds more than ${nf0.format(p.threshold_m2)} m² (best ${nf0.format(p.best_gain_m2)} m²) — finish it, or enlarge the area`;
+      progressLine.textContent = `mission complete: ${p.coverage_pct.toFixed(0)} % of the area scanned; no reachable point adds more than ${nf0.format(p.threshold_m2)} m² (best ${nf0.format(p.best_left_m2 ?? p.best_gain_m2)} m²) — finish it, or enlarge the area`;
     } else {
       const left = p.scans_left != null ? ` · ≈ ${p.scans_left} more scan${p.scans_left === 1 ? '' : 's'}` : '';
       const next = p.best_gain_m2 > 0 ? ` · next scan adds ≈ ${nf0.format(p.best_gain_m2)} m²` : '';

@@ -362,7 +362,7 @@ std::vector<FleetPlan> MissionPipeline::plan(const std::vector<FleetRobot>& robo
     r.memo = memos_->of(r.id);
   }
   return plan_fleet(mapping_.map(), *mapping_.target(), mapping_.scan_points(), drifting,
-                    std::move(claimed), config_.planner, anchored_map());
+                    std::move(claimed), planner_config(), anchored_map());
 }
 
 std::optional<DriveDrift> MissionPipeline::drift_of(const std::string& track) const {
@@ -401,7 +401,7 @@ std::vector<Eigen::Vector3d> MissionPipeline::unplaced_scan_points() const {
 Plan MissionPipeline::plan_from(const Eigen::Vector3d& robot, std::uint64_t seed,
                                 const std::string& track) const {
   if (!has_map()) return {};
-  PlannerConfig planner = config_.planner;
+  PlannerConfig planner = planner_config();
   planner.seed = seed;
   const std::vector<Eigen::Vector2d> points = mapping_.scan_points();
   PlanInput in{mapping_.map(), *mapping_.target(), points, robot};
@@ -412,6 +412,19 @@ Plan MissionPipeline::plan_from(const Eigen::Vector3d& robot, std::uint64_t seed
   if (drift) in.drift = &*drift;
   in.memo = memos_->of(track);
   return plan_next_scan(in, planner);
+}
+
+// Too rough to place a scan by themselves: as sensors_place judges it.
+PlannerConfig MissionPipeline::planner_config() const {
+  PlannerConfig planner = config_.planner;
+  const PoseNoise& noise = config_.pose_noise;
+  const double fix_xy = std::sqrt(2.0) * noise.xy_sigma_m;
+  const double fix_deg = std::sqrt(2.0) * noise.yaw_sigma_deg;
+  if (config_.matching && noise.model == OdometryModel::kAbsolute &&
+      (3 * fix_xy > kSensorsPlaceM || 3 * fix_deg > kSensorsPlaceDeg)) {
+    planner.registrability.min_pose_fixing *= planner.registrability.absolute_fix_factor;
+  }
+  return planner;
 }
 
 GainMemo* MissionPipeline::Memos::of(const std::string& robot) {

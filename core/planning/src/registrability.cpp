@@ -16,6 +16,9 @@ RegistrabilityField::RegistrabilityField(const MlsMap& anchored, CellIndex origi
       cols_(cols),
       rows_(rows),
       cells_(static_cast<std::size_t>(cols) * static_cast<std::size_t>(rows)) {
+  // The share of a cell within inlier_distance_m of one point in it.
+  const double near_area =
+      M_PI * config.inlier_distance_m * config.inlier_distance_m / (cell_m_ * cell_m_);
   for (int j = 0; j < rows; ++j) {
     for (int i = 0; i < cols; ++i) {
       const MlsCell* c = anchored.cell({origin.x + i, origin.y + j});
@@ -23,9 +26,15 @@ RegistrabilityField::RegistrabilityField(const MlsMap& anchored, CellIndex origi
       Cell& out = cells_[static_cast<std::size_t>(j) * static_cast<std::size_t>(cols) +
                          static_cast<std::size_t>(i)];
       out.mapped = 1;
+      if (c->interpolated) continue;  // heights between beams: no point to match against
+      double points = 0;
       for (const SurfacePatch& p : *c) {
+        points += p.count;
         if (p.extent() >= config.wall_min_extent_m) out.wall = 1;
       }
+      // In sixteenths: a cell a new scan adds a few points to keeps its odds once it holds a
+      // dozen, so the evaluations that read it stay reusable between plans (GainMemo).
+      out.odds = static_cast<float>(std::round(16 * (1 - std::exp(-points * near_area))) / 16);
     }
   }
   // A wall's normal is the direction across the walls around it: the minor axis of their
@@ -79,6 +88,7 @@ void RegistrabilityField::Forecast::add(std::uint32_t o, int di, int dj) {
   const Cell& c = f.cells_[o];
   if (!c.mapped) return;
   mapped_ += w;
+  on_map_ += w * c.odds;
   if (!c.wall) return;
   // The wall fixes the pose along its normal n: a row (n, p⊥·n) of the x, y, yaw Jacobian,
   // summed over the normals T = Σ n nᵀ stands for.
@@ -98,8 +108,8 @@ std::uint64_t RegistrabilityField::digest() const {
   using digest::mix;
   const RegistrabilityConfig& c = config_;
   std::uint64_t h = mix(std::uint64_t{0xF1E1D}, static_cast<std::uint64_t>(c.enabled));
-  for (const double v :
-       {c.min_overlap_share, c.min_pose_fixing, c.floor_share, c.near_range_m, cell_m_})
+  for (const double v : {c.min_overlap_share, c.min_pose_fixing, c.floor_share, c.near_range_m,
+                         c.inlier_distance_m, cell_m_})
     h = mix(h, v);
   return h;
 }
@@ -108,13 +118,13 @@ std::uint64_t RegistrabilityField::cell_digest(std::size_t offset) const {
   using digest::mix;
   const Cell& c = cells_[offset];
   const std::uint64_t flags = c.mapped | (std::uint64_t{c.wall} << 8);
-  return mix(mix(mix(mix(std::uint64_t{0xCE11}, flags), c.t_xx), c.t_xy), c.t_yy);
+  return mix(mix(mix(mix(mix(std::uint64_t{0xCE11}, flags), c.odds), c.t_xx), c.t_xy), c.t_yy);
 }
 
 Registrability RegistrabilityField::Forecast::result() const {
   const RegistrabilityConfig& cfg = field_.config_;
   Registrability out;
-  out.overlap_share = seen_ > 0 ? mapped_ / seen_ : 0.0;
+  out.overlap_share = seen_ > 0 ? on_map_ / seen_ : 0.0;
   if (walls_ > 0 && mapped_ > 0) {
     const double L = std::max(std::sqrt(r2_ / walls_), 1e-6);
     Eigen::Matrix3d info;

@@ -76,6 +76,8 @@ void check_config(const PlannerConfig& c) {
     fail("registrability.min_overlap_share must be in (0, 1]");
   if (!(r.min_pose_fixing > 0 && std::isfinite(r.min_pose_fixing)))
     fail("registrability.min_pose_fixing must be greater than zero");
+  if (!(r.absolute_fix_factor >= 1 && std::isfinite(r.absolute_fix_factor)))
+    fail("registrability.absolute_fix_factor must be at least 1");
   if (!(r.floor_share >= 0 && r.floor_share <= 1))
     fail("registrability.floor_share must be in [0, 1]");
   if (!(r.reach_xy_m > 0) || !(r.reach_yaw_deg > 0))
@@ -220,7 +222,8 @@ class SiteGains {
         sites_(sites),
         memo_(memo),
         fresh_(static_cast<std::size_t>(threads)),
-        reused_(static_cast<std::size_t>(threads), 0) {}
+        reused_(static_cast<std::size_t>(threads), 0),
+        best_gain_(static_cast<std::size_t>(threads), 0.0) {}
 
   VisibilityPredictor::Workspace workspace() const { return gain_.workspace(); }
 
@@ -239,6 +242,7 @@ class SiteGains {
       g = gain_.at(cell, floor_z, ws);
       if (memo_) fresh_[thread].push_back({cell, floor_z, g, ws.walks()});
     }
+    best_gain_[thread] = std::max(best_gain_[thread], g.unscanned_m2 + g.low_resolution_m2);
     if (g.registrability && !sites_.reach.empty()) {
       Registrability& r = *g.registrability;
       r.reach = sites_.reach[u];
@@ -258,6 +262,9 @@ class SiteGains {
     }
     return reused;
   }
+
+  // Plan::best_gain_m2. Outside parallel parts only.
+  double best_gain() const { return *std::max_element(best_gain_.begin(), best_gain_.end()); }
 
  private:
   struct Fresh {
@@ -279,6 +286,7 @@ class SiteGains {
   GainMemo* memo_;
   std::vector<std::vector<Fresh>> fresh_;
   std::vector<std::size_t> reused_;
+  std::vector<double> best_gain_;
 };
 
 // With drifting odometry, each site's drive_reach.
@@ -745,6 +753,7 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
   const std::vector<Scored> chosen =
       choose(cfg, gains, sites, plan.regions, in.map.cell_m(), threads, plan.evaluations);
   plan.reused = gains.keep_fresh();
+  plan.best_gain_m2 = gains.best_gain();
   plan.ranked = to_candidates(chosen, sites, in.map, travel);
   return finish();
 }

@@ -229,6 +229,27 @@ TEST_F(MissionPipelineTest, ExactSensorsPlaceAScanNoMatchPlaced) {
   // Sensors that err by a metre do not: that scan waits (AScanNothingTiesInStaysOutOfTheMap).
 }
 
+// From absolute fixes a match starts metres off with nothing nearer to go by: the planner asks
+// a candidate's walls to fix the pose more firmly than with odometry or exact sensors.
+TEST_F(MissionPipelineTest, AbsoluteFixesAskForFirmerWallsThanOdometryOrExactSensors) {
+  MissionConfig c = config();
+  const RegistrabilityConfig& r = c.planner.registrability;
+  const double base = r.min_pose_fixing;
+  const auto asked = [&] {
+    return MissionPipeline(c).planner_config().registrability.min_pose_fixing;
+  };
+  c.pose_noise = PoseNoise{};  // absolute, σ 1 m, 5°
+  EXPECT_DOUBLE_EQ(asked(), base * r.absolute_fix_factor);
+  EXPECT_DOUBLE_EQ(MissionPipeline(c).planner().registrability.min_pose_fixing, base);
+  c.pose_noise.model = OdometryModel::kDrift;
+  EXPECT_DOUBLE_EQ(asked(), base);
+  c.pose_noise = PoseNoise{0, 0, 0, OdometryModel::kAbsolute};
+  EXPECT_DOUBLE_EQ(asked(), base);
+  c.pose_noise = PoseNoise{};
+  c.matching.reset();
+  EXPECT_DOUBLE_EQ(asked(), base);
+}
+
 TEST_F(MissionPipelineTest, WithMatchingOffScansStayWhereTheRobotSays) {
   MissionConfig c = config();
   c.matching.reset();

@@ -63,8 +63,9 @@ void expect_same(const Plan& fresh, const Plan& memo, const std::string& where) 
 }
 
 // A mission of a few scans, each at the exhaustive plan's best point: at every step the plan
-// made with the memo is the plan made afresh, for each policy that evaluates F, and the memo
-// reuses evaluations once the scans move away from each other.
+// made with the memo is the plan made afresh, for each policy that evaluates F. Then a change
+// beyond the scanner's 80 m from part of the site (a post at its far end): the evaluations there
+// are reused, the others made anew, and the plan is still the one made afresh.
 TEST(GainMemo, PlansWithTheMemoAreThePlansMadeAfresh) {
   for (const unsigned seed : {3u, 11u}) {
     const World world = random_site(seed);
@@ -75,7 +76,8 @@ TEST(GainMemo, PlansWithTheMemoAreThePlansMadeAfresh) {
     std::vector<Eigen::Vector2d> points;
     Pose at = world.start;
     GainMemo exhaustive_memo, paper_memo;
-    std::size_t reused = 0;
+    PlannerConfig cfg;
+    cfg.visibility = VisibilityConfig::from_scanner(world.scanner);
     for (int scan = 1; scan <= 5; ++scan) {
       const PointCloud cloud = simulate_scan(caster, world.scanner, at, scan);
       const Eigen::Vector3d sensor(0, 0, world.scanner.mount_height_m);
@@ -85,25 +87,34 @@ TEST(GainMemo, PlansWithTheMemoAreThePlansMadeAfresh) {
       PlanInput in{map, target, points, {at.x, at.y, at.z}};
       in.anchored = &anchored;
       const std::string where = "seed " + std::to_string(seed) + ", scan " + std::to_string(scan);
-      PlannerConfig cfg;
-      cfg.visibility = VisibilityConfig::from_scanner(world.scanner);
       cfg.policy = PlannerPolicy::kExhaustive;
       const Plan fresh = plan_next_scan(in, cfg);
       in.memo = &exhaustive_memo;
       const Plan memo = plan_next_scan(in, cfg);
       expect_same(fresh, memo, where + " exhaustive");
-      reused += memo.reused;
       cfg.policy = PlannerPolicy::kPaper;
       cfg.seed = static_cast<std::uint64_t>(scan);
       in.memo = nullptr;
       const Plan paper_fresh = plan_next_scan(in, cfg);
       in.memo = &paper_memo;
-      expect_same(paper_fresh, plan_next_scan(in, cfg), where + " paper");
+      const Plan paper = plan_next_scan(in, cfg);
+      expect_same(paper_fresh, paper, where + " paper");
       if (fresh.ranked.empty()) break;
       const Eigen::Vector3d next = fresh.ranked.front().position;
       at = Pose{next.x(), next.y(), next.z(), 0, 0, 0};
     }
-    EXPECT_GT(reused, 0u) << "seed " << seed;
+    std::vector<Eigen::Vector3f> post;
+    for (float z = 0; z < 2; z += 0.1f) post.emplace_back(118.5f, 68.5f, z);
+    map.insert(post);
+    PlanInput in{map, target, points, {at.x, at.y, at.z}};
+    in.anchored = &anchored;
+    cfg.policy = PlannerPolicy::kExhaustive;
+    const Plan fresh = plan_next_scan(in, cfg);
+    in.memo = &exhaustive_memo;
+    const Plan memo = plan_next_scan(in, cfg);
+    expect_same(fresh, memo, "seed " + std::to_string(seed) + ", a post far off");
+    EXPECT_GT(memo.reused, 0u) << "seed " << seed;
+    EXPECT_LT(memo.reused, memo.evaluations) << "seed " << seed;
   }
 }
 

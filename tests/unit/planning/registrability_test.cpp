@@ -13,11 +13,14 @@ namespace {
 
 using Segment = std::pair<Eigen::Vector2d, Eigen::Vector2d>;
 
-// Flat ground over [0, 60)² below `ground_max_x`, and 3 m walls along the segments.
-MlsMap yard_with(const std::vector<Segment>& walls, double ground_max_x = 60) {
+// Flat ground over [0, 60)² below `ground_max_x`, a point every `ground_step_m` (densely
+// enough for every new point to have one within the matcher's 0.3 m), and 3 m walls along the
+// segments.
+MlsMap yard_with(const std::vector<Segment>& walls, double ground_max_x = 60,
+                 double ground_step_m = 0.1) {
   std::vector<Eigen::Vector3f> points;
-  for (double x = 0.25; x < ground_max_x; x += 0.5) {
-    for (double y = 0.25; y < 60; y += 0.5) {
+  for (double x = ground_step_m / 2; x < ground_max_x; x += ground_step_m) {
+    for (double y = ground_step_m / 2; y < 60; y += ground_step_m) {
       points.emplace_back(static_cast<float>(x), static_cast<float>(y), 0.0f);
     }
   }
@@ -83,6 +86,35 @@ TEST(Registrability, TheOverlapIsTheShareOfTheScanOnTheAnchoredMap) {
   RegistrabilityConfig off;
   off.enabled = false;
   EXPECT_EQ(forecast_at_centre(MlsMap{}, off).factor, 1.0);
+}
+
+// The matcher counts a point on the map when a map point lies within 0.3 m of it: ground
+// measured sparsely, or only interpolated between beams, is little to match against however much
+// of it the map holds.
+TEST(Registrability, SparseGroundAndHeightsBetweenBeamsAreLittleToMatchAgainst) {
+  const std::vector<Segment> walls = {{{5, 20.5}, {55, 20.5}}, {{20.5, 5}, {20.5, 55}}};
+  // Four points a 1 m cell: a new point has one within 0.3 m by 1 − exp(−4 π 0.09).
+  const Registrability sparse = forecast_at_centre(yard_with(walls, 60, 0.5));
+  EXPECT_NEAR(sparse.overlap_share, 1 - std::exp(-4 * M_PI * 0.09), 0.02);
+
+  // One scan's ground returns in two rings, at 4 m and 12 m of every degree: the cells between
+  // are filled with heights interpolated between the beams, with no point in them.
+  PointCloud scan;
+  for (int a = 0; a < 360; ++a) {
+    const double t = a * M_PI / 180;
+    for (const double r : {4.0, 12.0}) {
+      scan.push_back({static_cast<float>(r * std::cos(t)), static_cast<float>(r * std::sin(t)), 0},
+                     {1, 2, 3});
+    }
+  }
+  MlsMap rings;
+  rings.insert_scan(scan, Eigen::Isometry3d(Eigen::Translation3d(30.5, 30.5, 0)),
+                    Eigen::Vector3d(0, 0, 1));
+  const MlsCell* between = rings.cell(rings.index_of(38.5, 30.5));
+  ASSERT_NE(between, nullptr);
+  ASSERT_TRUE(between->interpolated);
+  // Counted whole, the cells from 4 to 12 m alone would be ~40 % of what the scan sees.
+  EXPECT_LT(forecast_at_centre(rings).overlap_share, 0.2);
 }
 
 // With odometry drifting 2 % of the drive and 0.3° per 10 m, the matcher's ±6 m search holds

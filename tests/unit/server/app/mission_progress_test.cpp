@@ -51,6 +51,24 @@ TEST(MissionProgress, CompleteWhenNoPointAddsEnoughUnlessAMoveIsUnderWay) {
   EXPECT_EQ(mission_progress(after.back(), after, plans, std::nullopt).state, "complete");
 }
 
+// The planner ranks a place the matcher cannot yet place a scan at behind the ones it can
+// (Plan::best_gain_m2): while the robot can go on, such a place keeps the mission running.
+TEST(MissionProgress, APlaceRankedBehindIsNotDone) {
+  const std::vector<MapAreas> after = {completed(28000), completed(29000), completed(29500)};
+  std::vector<PlanRecord> plans = {
+      {1, 3, "robot1", "paper", 0.5, 1, {offering(150), offering(90)}, 2400}};
+  const MissionProgress p = mission_progress(after.back(), after, plans, std::nullopt);
+  EXPECT_EQ(p.state, "running");
+  EXPECT_DOUBLE_EQ(p.best_gain_m2, 150);
+  EXPECT_DOUBLE_EQ(p.best_left_m2, 2400);
+  // Gains halving each scan: 2400 → 1200 → 600 → 300 → 150 (under 200) in four more.
+  ASSERT_TRUE(p.scans_left);
+  EXPECT_EQ(*p.scans_left, 4);
+  // Every suggestion refused: the plan leads nowhere, whatever it ranked behind.
+  for (CandidateRecord& c : plans[0].candidates) c.state = CandidateState::kRefused;
+  EXPECT_EQ(mission_progress(after.back(), after, plans, std::nullopt).state, "complete");
+}
+
 TEST(MissionProgress, TheOperatorsFinishStands) {
   const std::vector<MapAreas> after = {completed(1000)};
   const MissionProgress p = mission_progress(

@@ -151,6 +151,9 @@ class MissionPipeline {
     return anchored_map_ ? &*anchored_map_ : nullptr;
   }
   const PlannerConfig& planner() const { return config_.planner; }
+  // planner() as the plans use it: from absolute fixes too rough to place a scan by themselves,
+  // a candidate's walls must fix the pose more firmly (RegistrabilityConfig::absolute_fix_factor).
+  PlannerConfig planner_config() const;
   const MissionConfig& config() const { return config_; }
   // Whether there is a map to plan on (a first scan, its regions and movable region).
   bool has_map() const;

@@ -20,7 +20,22 @@ struct RegistrabilityConfig {
   // least floor_share. Calibrated on the campus loop against the match outcomes
   // (docs/planner.md): below an overlap share of 0.09 no match was applied.
   double min_overlap_share = 0.3;
+  // The matcher counts a point as on the map when a map point lies this near it
+  // (RegistrationConfig::inlier_distance_m). A cell of the anchored map holding n measured points
+  // counts as overlap by the chance that one lies this near a new point in it, 1 − exp(−n·π·d² /
+  // cell area): the ground 40 m from every scanner holds a point every few metres, or only
+  // heights interpolated between beams, and a scan there found 3–10 % of its points on the map
+  // where counting such cells whole forecast 30–60 % (issue 15).
+  double inlier_distance_m = 0.3;
   double min_pose_fixing = 0.002;
+  // Where the scans' poses come from absolute fixes (σ 1 m, 5°, no odometry between them), a
+  // match starts metres and degrees off with nothing nearer to go by, and before weak walls GICP
+  // settles elsewhere: a candidate then needs this many times min_pose_fixing
+  // (MissionPipeline). On the campus with absolute fixes (30 scans, seeds 1–5) matches at
+  // forecasts of 0.002–0.004 were refused a third of the time (one street, one facade), above
+  // one in nine; with drifting odometry, whose match starts decimetres off, the higher threshold
+  // cost coverage and placed no more scans right (docs/benchmarks.md, 2026-12-04).
+  double absolute_fix_factor = 2.0;
   double floor_share = 0.05;
   // A cell of the anchored map holding a surface at least this deep is a wall: it fixes the
   // pose across itself. Kerbs and low steps fix little; ground fixes only z, roll and pitch.
@@ -93,7 +108,9 @@ class RegistrabilityField {
 
    private:
     const RegistrabilityField& field_;
-    double seen_ = 0, mapped_ = 0;
+    // mapped_: weight on any cell the map holds (pose fixing is per unit of it); on_map_: the
+    // same by each cell's odds (the overlap share).
+    double seen_ = 0, mapped_ = 0, on_map_ = 0;
     // Weighted sums over the walls seen: Σ T, Σ T·p⊥, Σ p⊥ᵀ·T·p⊥, Σ |p|², Σ w, where T is the
     // wall's normal tensor and p⊥ its position turned by 90° (the yaw lever).
     double t_xx_ = 0, t_xy_ = 0, t_yy_ = 0, tp_x_ = 0, tp_y_ = 0, ptp_ = 0, r2_ = 0, walls_ = 0;
@@ -104,6 +121,7 @@ class RegistrabilityField {
     // n nᵀ of the wall's normal (in the x-y plane); I/2 where the walls around have no one
     // direction (a post, a corner); zero where there is no wall.
     float t_xx = 0, t_xy = 0, t_yy = 0;
+    float odds = 0;  // that a new point here has a measured map point within inlier_distance_m
     std::uint8_t mapped = 0, wall = 0;
   };
   RegistrabilityConfig config_;

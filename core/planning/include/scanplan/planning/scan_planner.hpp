@@ -149,6 +149,11 @@ struct Plan {
   MovableRegion movable;
   std::size_t evaluations = 0;  // F values the policy looked at
   std::size_t reused = 0;       // of them, taken from PlanInput::memo
+  // The most a scan at any place the policy looked at would add (unscanned and low-resolution
+  // area), whether or not the matcher is forecast to place it: the ranking puts such places
+  // behind ones it can place, but while one is left the mission is not done (it becomes
+  // placeable once scans nearer it are in the map).
+  double best_gain_m2 = 0;
   double plan_ms = 0;
 };
 
