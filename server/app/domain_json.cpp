@@ -70,7 +70,10 @@ json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas, bool i
           {"points", s.points},
           {"estimated", pose_json(s.estimated)},
           {"placed", pose_json(s.placed)},
-          {"goal", s.goal ? json{{"x", s.goal->x()}, {"y", s.goal->y()}, {"z", s.goal->z()}}
+          {"goal", s.goal ? json{{"x", s.goal->x()},
+                                 {"y", s.goal->y()},
+                                 {"z", s.goal->z()},
+                                 {"drive_m", s.goal_drive_m}}
                           : json(nullptr)},
           {"received_at", s.received_at},
           {"match", match_json(s.match)},

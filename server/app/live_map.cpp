@@ -39,6 +39,7 @@ Placement placement_of(const StoredScan& scan) {
   if (scan.match) where.information = scan.match->information;
   where.track = scan.robot;
   where.goal = scan.goal;
+  where.driven_m = scan.goal_drive_m;
   return where;
 }
 
@@ -104,13 +105,13 @@ const std::vector<std::string>& LiveMap::layer_names() {
 }
 
 std::optional<MapMatch> LiveMap::place(const PointCloud& scan, const Pose& reported,
-                                       const std::string& robot) const {
+                                       const std::string& robot, double driven_m) const {
   // Only the copy of the map's points near the scan under the lock: the match itself takes
   // hundreds of milliseconds, and parameter changes and goals must not wait for it.
   std::optional<MissionPipeline::MatchInput> in;
   {
     std::lock_guard encode_lock(encode_mutex_);
-    in = mission_.match_input(reported, robot);
+    in = mission_.match_input(reported, robot, driven_m);
   }
   if (!in) return std::nullopt;
   return match_to_map(in->map_points, scan, in->prior, in->config, in->views);

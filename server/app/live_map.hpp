@@ -87,7 +87,7 @@ class LiveMap {
   double sensor_height_m() const { return sensor_height_m_; }
   // Where `robot` was sent for the scan it sends now, if it arrived at an approved candidate
   // (PlanBook::take_reached_goal): stored with the scan.
-  std::optional<Eigen::Vector3d> take_reached_goal(const std::string& robot) {
+  std::optional<ReachedGoal> take_reached_goal(const std::string& robot) {
     return plans_.take_reached_goal(robot);
   }
   ~LiveMap();
@@ -151,10 +151,11 @@ class LiveMap {
   };
   Held held() const;
   // Where a new scan of `robot` goes: matched against the map so far (MissionPipeline::place;
-  // with drifting odometry from the robot's latest placed scan). Nothing when matching is off
-  // or the map is empty. Call from the thread that calls add().
+  // with drifting odometry from the robot's latest placed scan, `driven_m` the path it was sent
+  // along since). Nothing when matching is off or the map is empty. Call from the thread that
+  // calls add().
   std::optional<MapMatch> place(const PointCloud& scan, const Pose& reported,
-                                const std::string& robot = {}) const;
+                                const std::string& robot = {}, double driven_m = 0) const;
   std::size_t scan_count() const;
   std::optional<StoredScan> last_scan() const;
   std::size_t point_count() const;

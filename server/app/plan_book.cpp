@@ -80,7 +80,7 @@ bool PlanBook::set_candidate_state(std::uint64_t id, CandidateState state,
       if (state == CandidateState::kRefused)
         refused_[robot].push_back({c.candidate.position.head<2>(), latest_scan_});
       if (state == CandidateState::kReached) {
-        reached_[robot] = c.candidate.position;
+        reached_[robot] = {c.candidate.position, c.candidate.travel_m};
       } else if (state != CandidateState::kRejected) {
         reached_.erase(robot);  // moving on, or stopped short of it
       }
@@ -139,11 +139,11 @@ std::map<std::string, Eigen::Vector3d> PlanBook::driving_goals() const {
   return goals;
 }
 
-std::optional<Eigen::Vector3d> PlanBook::take_reached_goal(const std::string& robot) {
+std::optional<ReachedGoal> PlanBook::take_reached_goal(const std::string& robot) {
   std::lock_guard lock(mutex_);
   const auto it = reached_.find(robot);
   if (it == reached_.end()) return std::nullopt;
-  const Eigen::Vector3d goal = it->second;
+  const ReachedGoal goal = it->second;
   reached_.erase(it);
   return goal;
 }

@@ -35,6 +35,13 @@ struct PlanRecord {
   double best_gain_m2 = 0;  // Plan::best_gain_m2
 };
 
+// Where a robot arrived that it was sent to: the candidate's place (map frame) and the length
+// of the path the planner gave it there (Candidate::travel_m; odometry drifts with it).
+struct ReachedGoal {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  double drive_m = 0;
+};
+
 // The heading a robot takes at candidate `c`: along the last leg of its path, so the scan starts
 // looking where the robot went (0 without a path). Degrees, map frame.
 double approach_yaw_deg(const Candidate& c);
@@ -75,7 +82,7 @@ class PlanBook {
   // it sends was taken there (StoredScan::goal). A new approval, a refusal, a cancellation or an
   // interruption of that robot's move forgets it, so a scan after those is not claimed at a
   // place never reached.
-  std::optional<Eigen::Vector3d> take_reached_goal(const std::string& robot);
+  std::optional<ReachedGoal> take_reached_goal(const std::string& robot);
   // Where the robots other than `robot` are going to scan next: the goals of approved moves,
   // else the best candidates of their plans.
   std::vector<Eigen::Vector3d> claims_except(const std::string& robot) const;
@@ -97,7 +104,7 @@ class PlanBook {
  private:
   mutable std::mutex mutex_;
   std::map<std::string, PlanRecord> plans_;              // by robot
-  std::map<std::string, Eigen::Vector3d> reached_;       // by robot: take_reached_goal
+  std::map<std::string, ReachedGoal> reached_;           // by robot: take_reached_goal
   std::map<std::string, std::vector<Refusal>> refused_;  // by robot
   std::int64_t latest_scan_ = 0;
   std::string latest_robot_;

@@ -119,8 +119,10 @@ SubmittedScan ScanIntake::submit(const std::string& robot, const Pose& estimated
         robot, dropped.non_finite, dropped.out_of_range, dropped.mount, dropped.saturated);
   }
   // Matching will correct `placed`; until then the reported pose is the best there is.
+  const std::optional<ReachedGoal> goal = live_.take_reached_goal(robot);
   StoredScan stored = session_.add_scan(robot, estimated, estimated, stamp_ns, cloud,
-                                        live_.take_reached_goal(robot));
+                                        goal ? std::optional(goal->position) : std::nullopt,
+                                        goal ? goal->drive_m : 0);
   {
     std::lock_guard lock(mutex_);
     queue_.push_back({stored, std::move(cloud)});
@@ -134,7 +136,8 @@ SubmittedScan ScanIntake::submit(const std::string& robot, const Pose& estimated
 }
 
 StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
-  const std::optional<MapMatch> matched = live_.place(cloud, scan.estimated, scan.robot);
+  const std::optional<MapMatch> matched =
+      live_.place(cloud, scan.estimated, scan.robot, scan.goal_drive_m);
   if (!matched) return scan;
   const MapMatch& m = *matched;
   const Pose& e = scan.estimated;

@@ -109,7 +109,9 @@ constexpr const char* kScanColumns =
 const std::string kScanSelect =
     std::string("SELECT ") + kScanColumns +
     ", applied, converged, method, matches.reason, time_ms, inlier_ratio, "
-    "ex.excluded, ex.actor, ex.reason, ex.at, matches.information, goal_x, goal_y, goal_z FROM "
+    "ex.excluded, ex.actor, ex.reason, ex.at, matches.information, goal_x, goal_y, goal_z, "
+    "goal_drive_m "
+    "FROM "
     "scans "
     "LEFT JOIN matches "
     "ON matches.scan_id = scans.id LEFT JOIN (SELECT scan_id, excluded, actor, reason, at FROM "
@@ -162,6 +164,7 @@ StoredScan scan_from_row(const Statement& s) {
   if (r.match && !s.null(28)) r.match->information = information_from_text(s.text(28));
   if (!s.null(29) && !s.null(30) && !s.null(31))
     r.goal = Eigen::Vector3d(s.real(29), s.real(30), s.real(31));
+  if (r.goal && !s.null(32)) r.goal_drive_m = s.real(32);
   return r;
 }
 
@@ -258,7 +261,7 @@ SessionStore::SessionStore(std::filesystem::path dir) : dir_(created(std::move(d
   if (!has_column("matches", "information"))
     exec("ALTER TABLE matches ADD COLUMN information TEXT");
   // Nor where the robot was sent for each scan (NULL: it was not, or not known).
-  for (const char* column : {"goal_x", "goal_y", "goal_z"}) {
+  for (const char* column : {"goal_x", "goal_y", "goal_z", "goal_drive_m"}) {
     if (!has_column("scans", column))
       exec((std::string("ALTER TABLE scans ADD COLUMN ") + column + " REAL").c_str());
   }
@@ -351,7 +354,7 @@ void SessionStore::tidy_scan_files() const {
 StoredScan SessionStore::add_scan(const std::string& robot, const Pose& estimated,
                                   const Pose& placed, std::int64_t stamp_ns,
                                   const PointCloud& cloud,
-                                  const std::optional<Eigen::Vector3d>& goal) {
+                                  const std::optional<Eigen::Vector3d>& goal, double goal_drive_m) {
   std::lock_guard lock(mutex_);
   exec("BEGIN IMMEDIATE");
   try {
@@ -371,11 +374,12 @@ StoredScan SessionStore::add_scan(const std::string& robot, const Pose& estimate
     r.file = name;
     r.received_at = utc_now();
     r.goal = goal;
+    r.goal_drive_m = goal ? goal_drive_m : 0;
     write_durably(dir_ / r.file, write_ply_bytes(cloud, {"scanplan robot " + robot}));
-    Statement ins(db_,
-                  (std::string("INSERT INTO scans(") + kScanColumns +
-                   ", goal_x, goal_y, goal_z) VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)")
-                      .c_str());
+    Statement ins(db_, (std::string("INSERT INTO scans(") + kScanColumns +
+                        ", goal_x, goal_y, goal_z, goal_drive_m) "
+                        "VALUES(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)")
+                           .c_str());
     const Pose& e = estimated;
     const Pose& p = placed;
     ins.bind(1, r.id).bind(2, robot);
@@ -383,7 +387,9 @@ StoredScan SessionStore::add_scan(const std::string& robot, const Pose& estimate
     ins.bind(9, p.x).bind(10, p.y).bind(11, p.z).bind(12, p.roll).bind(13, p.pitch).bind(14, p.yaw);
     ins.bind(15, stamp_ns).bind(16, static_cast<std::int64_t>(r.points)).bind(17, r.file);
     ins.bind(18, r.received_at);
-    if (goal) ins.bind(19, goal->x()).bind(20, goal->y()).bind(21, goal->z());
+    if (goal) {
+      ins.bind(19, goal->x()).bind(20, goal->y()).bind(21, goal->z()).bind(22, r.goal_drive_m);
+    }
     ins.step();
     exec("COMMIT");
     return r;

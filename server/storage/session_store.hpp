@@ -67,6 +67,9 @@ struct StoredScan {
   // Where the robot was sent for this scan (the approved candidate it reached, map frame): a
   // scan the map cannot place is claimed for the planner there (Placement::goal).
   std::optional<Eigen::Vector3d> goal;
+  // The length of the path the planner gave the robot there (0: not known): odometry drifts
+  // with the path driven (Placement::driven_m).
+  double goal_drive_m = 0;
 };
 
 // One row of the session's record of what happened (append_event).
@@ -113,11 +116,12 @@ class SessionStore {
 
   const std::filesystem::path& dir() const { return dir_; }
 
-  // `cloud` in the scan's own frame; `goal` where the robot was sent for it, if it was. Returns
-  // the new scan with its id.
+  // `cloud` in the scan's own frame; `goal` where the robot was sent for it, if it was, and
+  // `goal_drive_m` the path there (StoredScan). Returns the new scan with its id.
   StoredScan add_scan(const std::string& robot, const Pose& estimated, const Pose& placed,
                       std::int64_t stamp_ns, const PointCloud& cloud,
-                      const std::optional<Eigen::Vector3d>& goal = std::nullopt);
+                      const std::optional<Eigen::Vector3d>& goal = std::nullopt,
+                      double goal_drive_m = 0);
   // Records how matching went for scan `id` and where the scan was placed (the match's
   // correction, or the reported pose carried into the map frame when it was refused): both in
   // one transaction.

@@ -70,14 +70,17 @@ std::optional<std::size_t> drive_to_best(const WorldTraversability& trav,
 }
 
 // The scan matched against the map and joined, the graph optimised: step's poses and match.
+// `goal`, `driven_m`: where the robot was sent and the length of the path the planner gave it
+// there (Placement).
 void place(MissionPipeline& mission, const PointCloud& cloud, LoopStep& step,
-           const std::optional<Eigen::Vector3d>& goal) {
+           const std::optional<Eigen::Vector3d>& goal, double driven_m) {
   step.prior_pose = mission.prior(step.reported_pose, kTrack);
   step.matched_pose = step.prior_pose;
   Placement where{step.reported_pose, step.prior_pose, false};
   where.track = kTrack;
   where.goal = goal;
-  if (const auto m = mission.place(cloud, step.reported_pose, kTrack)) {
+  where.driven_m = driven_m;
+  if (const auto m = mission.place(cloud, step.reported_pose, kTrack, driven_m)) {
     step.match = m->result;
     step.match_applied = m->applied;
     step.matched_pose = m->placed;
@@ -242,6 +245,7 @@ LoopResult run_closed_loop(
   SimulatedOdometry odometry(world.pose_noise, truth, config.seed);
   double path_m = 0;
   std::optional<Eigen::Vector3d> goal;  // where the robot was last sent, on the map
+  double goal_travel_m = 0;             // the planned path there
   for (int scan = 1; scan <= config.max_scans; ++scan) {
     LoopStep step;
     step.scan = scan;
@@ -256,7 +260,7 @@ LoopResult run_closed_loop(
       ground = reachable_ground_cells(world, trav, start_reach, pipeline.map(), map_from_world);
       result.reachable_cells = ground.size();
     }
-    place(mission, cloud, step, goal);
+    place(mission, cloud, step, goal, goal_travel_m);
     if (!result.steps.empty()) step_errors(result.steps.front(), step);
     const RegionMap& regions = *pipeline.regions();
     step.detected_m2 = regions.detected_m2();
@@ -286,6 +290,7 @@ LoopResult run_closed_loop(
       if (step.chosen) {
         odometry.moved(truth, path_m - before);
         goal = plan.ranked[*step.chosen].position;
+        goal_travel_m = plan.ranked[*step.chosen].travel_m;
       }
     }
     if (on_step) on_step(step, pipeline);

@@ -82,13 +82,14 @@ bool MissionPipeline::has_map() const {
   return mapping_.regions() && mapping_.movable() && mapping_.target();
 }
 
-std::optional<MissionPipeline::MatchInput> MissionPipeline::match_input(
-    const Pose& reported, const std::string& track) const {
+std::optional<MissionPipeline::MatchInput> MissionPipeline::match_input(const Pose& reported,
+                                                                        const std::string& track,
+                                                                        double driven_m) const {
   if (!config_.matching || placed_.empty()) return std::nullopt;
   const Pose start = prior(reported, track);
   MapMatchConfig config = *config_.matching;
   if (graph_) {
-    if (const auto prior = graph_->prior_uncertainty(track, reported)) {
+    if (const auto prior = graph_->prior_uncertainty(track, reported, driven_m)) {
       config = widened(config, *prior);
     }
   }
@@ -99,8 +100,8 @@ std::optional<MissionPipeline::MatchInput> MissionPipeline::match_input(
 }
 
 std::optional<MapMatch> MissionPipeline::place(const PointCloud& scan, const Pose& reported,
-                                               const std::string& track) const {
-  const std::optional<MatchInput> in = match_input(reported, track);
+                                               const std::string& track, double driven_m) const {
+  const std::optional<MatchInput> in = match_input(reported, track, driven_m);
   if (!in) return std::nullopt;
   return match_to_map(in->map_points, scan, in->prior, in->config, in->views);
 }
@@ -198,7 +199,7 @@ std::optional<MissionPipeline::SensorFix> MissionPipeline::sensors_place(
          std::sqrt(2.0) * noise.yaw_sigma_deg};
   } else {
     const auto last = graph_->last_anchored_of(where.track);
-    const auto prior = graph_->prior_uncertainty(where.track, where.reported);
+    const auto prior = graph_->prior_uncertainty(where.track, where.reported, where.driven_m);
     if (!last || !prior) return std::nullopt;
     u = *prior;
     from = *last;
@@ -219,7 +220,8 @@ std::optional<MissionPipeline::SensorFix> MissionPipeline::sensors_place(
 // off by more than that.
 bool MissionPipeline::unsure(const Placement& where) const {
   const PoseChange d = change(prior(where.reported, where.track), where.placed);
-  const std::optional<MoveUncertainty> u = graph_->prior_uncertainty(where.track, where.reported);
+  const std::optional<MoveUncertainty> u =
+      graph_->prior_uncertainty(where.track, where.reported, where.driven_m);
   return d.metres > config_.matching->max_correction_m ||
          d.degrees > config_.matching->max_correction_deg || (u && beyond_reach(*u));
 }

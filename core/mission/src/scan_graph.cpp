@@ -60,11 +60,11 @@ RegistrationConfig widened(RegistrationConfig config, const MoveUncertainty& pri
   return config;
 }
 
-MoveUncertainty ScanGraph::odometry_uncertainty(const RelativePose& move) const {
+MoveUncertainty ScanGraph::odometry_uncertainty(const RelativePose& move, double driven_m) const {
   if (noise_.model == OdometryModel::kDrift) {
     // The robot drives around what is in its way: the path is longer than the straight line
     // between the two reports, and the drift grows with the path.
-    const double d = config_.path_factor * std::hypot(move.x, move.y);
+    const double d = std::max(config_.path_factor * std::hypot(move.x, move.y), driven_m);
     return {std::max(noise_.xy_drift_fraction * d, config_.min_odometry_sigma_m),
             std::max(noise_.z_drift_fraction * d, config_.min_odometry_sigma_m),
             std::max(noise_.yaw_drift_deg_per_10m * d / 10.0, config_.min_odometry_sigma_deg)};
@@ -90,19 +90,20 @@ std::optional<std::size_t> ScanGraph::last_anchored_of(const std::string& track)
 }
 
 std::optional<MoveUncertainty> ScanGraph::prior_uncertainty(const std::string& track,
-                                                            const Pose& reported) const {
+                                                            const Pose& reported,
+                                                            double driven_m) const {
   const auto from = last_anchored_of(track);
   if (!from || noise_.model != OdometryModel::kDrift) return std::nullopt;
-  // The robot's reports from that scan on, then `reported`.
-  std::vector<const Pose*> stops;
+  // The robot's reports from that scan on, then `reported`, each with the drive to it.
+  std::vector<std::pair<const Pose*, double>> stops;
   for (std::size_t i = *from; i < tracks_.size(); ++i) {
-    if (tracks_[i] == track) stops.push_back(&reported_[i]);
+    if (tracks_[i] == track) stops.emplace_back(&reported_[i], driven_[i]);
   }
-  stops.push_back(&reported);
+  stops.emplace_back(&reported, driven_m);
   MoveUncertainty u;
   for (std::size_t s = 1; s < stops.size(); ++s) {
-    const RelativePose move = relative_pose(*stops[s - 1], *stops[s]);
-    const MoveUncertainty m = odometry_uncertainty(move);
+    const RelativePose move = relative_pose(*stops[s - 1].first, *stops[s].first);
+    const MoveUncertainty m = odometry_uncertainty(move, stops[s].second);
     const double swing = std::hypot(move.x, move.y) * deg2rad(u.yaw_deg);
     u.xy_m = std::sqrt(u.xy_m * u.xy_m + m.xy_m * m.xy_m + swing * swing);
     u.z_m = std::hypot(u.z_m, m.z_m);
@@ -123,15 +124,16 @@ std::optional<std::size_t> ScanGraph::last_of(const std::string& track) const {
 GraphUpdate ScanGraph::add(const PointCloud& scan, const Placement& where, bool tentative,
                            const Viewpoints& scanner) {
   const MoveUncertainty uncertain =
-      where.matched && !tentative
-          ? MoveUncertainty{}
-          : prior_uncertainty(where.track, where.reported).value_or(MoveUncertainty{});
+      where.matched && !tentative ? MoveUncertainty{}
+                                  : prior_uncertainty(where.track, where.reported, where.driven_m)
+                                        .value_or(MoveUncertainty{});
   const std::size_t k = graph_.add_node(where.placed);
   const RegistrationConfig adapted = adapted_config(scan, config_.registration);
   thinned_.push_back(std::make_shared<const PointCloud>(
       levelled(voxel_downsample(scan, adapted.voxel_m), where.placed)));
   scanners_.push_back(scanner);
   reported_.push_back(where.reported);
+  driven_.push_back(where.driven_m);
   tracks_.push_back(where.track);
   const bool matched = where.matched && !tentative;
   anchored_.push_back(k == 0 || matched ? 1 : 0);
@@ -164,7 +166,7 @@ bool ScanGraph::odometry_agrees(std::size_t a, const Pose& a_placed, std::size_t
                                 const Pose& b_placed) const {
   const RelativePose move = relative_pose(reported_[a], reported_[b]);
   const Pose predicted = compose(a_placed, move, b_placed.roll, b_placed.pitch);
-  const MoveUncertainty u = odometry_uncertainty(move);
+  const MoveUncertainty u = odometry_uncertainty(move, previous_[b] == a ? driven_[b] : 0.0);
   const double off_m = std::hypot(predicted.x - b_placed.x, predicted.y - b_placed.y);
   const double off_deg = std::abs(rad2deg(std::remainder(predicted.yaw - b_placed.yaw, 2 * M_PI)));
   // Never looser than a few metres: a look-alike lies a building's depth off, and a long drive's
@@ -224,7 +226,7 @@ GraphSolveReport ScanGraph::solve() {
 
 void ScanGraph::add_odometry(std::size_t from, std::size_t to) {
   const RelativePose move = relative_pose(reported_[from], reported_[to]);
-  const MoveUncertainty u = odometry_uncertainty(move);
+  const MoveUncertainty u = odometry_uncertainty(move, driven_[to]);
   graph_.add_edge({from, to, move, diagonal_information(u.xy_m, u.z_m, deg2rad(u.yaw_deg)),
                    EdgeKind::kOdometry});
   origins_.emplace_back("odometry");
@@ -350,7 +352,7 @@ void ScanGraph::match_pairs(std::size_t k, bool matched_to_map, GraphUpdate& upd
 // each end's own estimate may be off.
 MoveUncertainty ScanGraph::relative_uncertainty(std::size_t from, std::size_t to) const {
   if (previous_[to] == from)
-    return odometry_uncertainty(relative_pose(reported_[from], reported_[to]));
+    return odometry_uncertainty(relative_pose(reported_[from], reported_[to]), driven_[to]);
   const MoveUncertainty& f = uncertain_[from];
   const MoveUncertainty& t = uncertain_[to];
   return {std::hypot(f.xy_m, t.xy_m), std::hypot(f.z_m, t.z_m), std::hypot(f.yaw_deg, t.yaw_deg)};

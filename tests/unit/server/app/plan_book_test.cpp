@@ -10,6 +10,7 @@ CandidateRecord at(std::uint64_t id, int rank, double x) {
   c.id = id;
   c.rank = rank;
   c.candidate.position = {x, 0, 0};
+  c.candidate.travel_m = 2.5 * x;
   return c;
 }
 
@@ -70,7 +71,8 @@ TEST(PlanBook, ARobotThatReachedItsGoalWasSentThereForItsNextScanOnly) {
   book.set_candidate_state(2, CandidateState::kRejected, "not there");
   const auto goal = book.take_reached_goal("a");
   ASSERT_TRUE(goal) << "a rejection of another candidate does not forget the arrival";
-  EXPECT_EQ(goal->x(), 10);
+  EXPECT_EQ(goal->position.x(), 10);
+  EXPECT_EQ(goal->drive_m, 25) << "the path the planner gave it there";
   EXPECT_FALSE(book.take_reached_goal("a")) << "taken by the scan made there";
   EXPECT_FALSE(book.take_reached_goal("b"));
   for (const CandidateState stop :

@@ -39,8 +39,9 @@ TEST_F(SessionDir, ScansSurviveReopeningWithPosesAndPoints) {
   {
     SessionStore s(dir_);
     EXPECT_EQ(s.add_scan("robot1", est, placed, 42, cloud_of(10, 0)).id, 1);
-    EXPECT_EQ(s.add_scan("robot2", est, placed, 43, cloud_of(5, 100), Eigen::Vector3d(7, 8, 9)).id,
-              2);
+    EXPECT_EQ(
+        s.add_scan("robot2", est, placed, 43, cloud_of(5, 100), Eigen::Vector3d(7, 8, 9), 41.5).id,
+        2);
     s.append_event("approval", R"({"candidate":1,"by":"operator"})");
   }
   SessionStore s(dir_);
@@ -54,6 +55,8 @@ TEST_F(SessionDir, ScansSurviveReopeningWithPosesAndPoints) {
   EXPECT_FALSE(scans[0].goal) << "robot1 was not sent anywhere";
   ASSERT_TRUE(scans[1].goal);
   EXPECT_EQ(*scans[1].goal, Eigen::Vector3d(7, 8, 9));
+  EXPECT_EQ(scans[1].goal_drive_m, 41.5);
+  EXPECT_EQ(scans[0].goal_drive_m, 0);
   const PointCloud back = s.load_points(scans[1]);
   ASSERT_EQ(back.size(), 5u);
   EXPECT_EQ(back.points[4], Eigen::Vector3f(104, 8, 0.5f));

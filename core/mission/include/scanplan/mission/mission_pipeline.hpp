@@ -71,8 +71,9 @@ class MissionPipeline {
   // session's passes over one site made the match grow with it). A scan left unmatched is
   // metres off as often as not; matched against, it would pull every later scan near it off
   // with it. Nothing when matching is off or nothing is anchored yet. Changes nothing.
+  // `driven_m`: the path the robot was sent along since its previous scan (Placement::driven_m).
   std::optional<MapMatch> place(const PointCloud& scan, const Pose& reported,
-                                const std::string& track = {}) const;
+                                const std::string& track = {}, double driven_m = 0) const;
   // place() in two steps, for an owner that matches without holding its lock: what the match
   // needs from the map (nothing when there is nothing to match against), then match_to_map.
   struct MatchInput {
@@ -81,7 +82,8 @@ class MissionPipeline {
     Pose prior;        // the reported pose in the map frame: where the match starts
     MatchViews views;  // where map_points were seen from, and the new scan's scanner
   };
-  std::optional<MatchInput> match_input(const Pose& reported, const std::string& track = {}) const;
+  std::optional<MatchInput> match_input(const Pose& reported, const std::string& track = {},
+                                        double driven_m = 0) const;
   // `reported` carried into the map frame by what the anchored scans say of the pose sensors'
   // frame (SensorFrame): where an unmatched scan is best placed.
   // With drifting odometry and the graph on, the robot's latest scan as the graph has it,

@@ -27,6 +27,10 @@ struct Placement {
   // a scan that cannot be placed is claimed for the planner there as well as at its estimate,
   // which for a lost robot lies tens of metres off (MissionPipeline::unplaced_scan_points).
   std::optional<Eigen::Vector3d> goal;
+  // How far the robot was sent along its path since its previous scan (Candidate::travel_m of
+  // the approved goal), 0 when unknown. Odometry drifts with the path driven, and a drive round
+  // a building can be four times the straight line between the two reports (DriftOdometry).
+  double driven_m = 0;
 };
 
 }  // namespace scanplan

@@ -54,6 +54,7 @@ struct ScanGraphConfig {
   double pair_sigma_m = 0.03;
   // Odometry edges: a drive around what is in the way is longer than the straight line between
   // the two reports, and the drift grows with the path (DESIGN.md: 2 % of the distance driven).
+  // Where the path the robot was sent along is known (Placement::driven_m) and longer, it counts.
   double path_factor = 1.5;
   // Odometry edges are never surer than this (a robot that did not move still slips).
   double min_odometry_sigma_m = 0.05;
@@ -142,13 +143,15 @@ class ScanGraph {
   std::optional<std::size_t> last_of(const std::string& track) const;
   // The latest scan of a robot that is anchored, if any.
   std::optional<std::size_t> last_anchored_of(const std::string& track) const;
-  // How wrong odometry over `move` (reported poses) may be, by the noise model.
-  MoveUncertainty odometry_uncertainty(const RelativePose& move) const;
+  // How wrong odometry over `move` (reported poses) may be, by the noise model; `driven_m`: the
+  // path driven, when known (0: path_factor times the straight line).
+  MoveUncertainty odometry_uncertainty(const RelativePose& move, double driven_m = 0) const;
   // How wrong a pose carried by odometry from the robot's latest anchored scan to `reported`
   // may be: the error of each move since, one after the other (a heading error swinging the
-  // moves after it). Nothing for a robot's first scan or absolute fixes.
-  std::optional<MoveUncertainty> prior_uncertainty(const std::string& track,
-                                                   const Pose& reported) const;
+  // moves after it); `driven_m` is the last move's path (Placement::driven_m). Nothing for a
+  // robot's first scan or absolute fixes.
+  std::optional<MoveUncertainty> prior_uncertainty(const std::string& track, const Pose& reported,
+                                                   double driven_m = 0) const;
   const Pose& reported(std::size_t scan) const { return reported_.at(scan); }
   // The scan levelled at its pose (levelled()), thinned as matching thins it.
   const PointCloud& thinned(std::size_t scan) const { return *thinned_.at(scan); }
@@ -208,6 +211,7 @@ class ScanGraph {
   std::vector<std::shared_ptr<const PointCloud>> thinned_;  // levelled, per scan
   std::vector<Viewpoints> scanners_;                        // per scan, as add() was told
   std::vector<Pose> reported_;
+  std::vector<double> driven_;  // per scan: Placement::driven_m, the drive that led to it
   std::vector<std::uint8_t> anchored_;
   std::vector<MoveUncertainty> uncertain_;  // per scan: of its estimate while not anchored
   std::map<std::string, std::size_t> last_of_track_;
