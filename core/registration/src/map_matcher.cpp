@@ -97,14 +97,17 @@ MapMatch match_to_map(const PointCloud& map_points, const PointCloud& scan, cons
   // The search ranks fits by their prior, but takes a far one when it found nothing nearer; on
   // the campus one spot refused at its true pose (5.8–8.6 % inliers) was matched 4–5.5 m off
   // (4–5σ) in five runs of ten, and the map around it followed (issue 17). Waiting for
-  // confirmation did not help: a neighbour found the same look-alike.
+  // confirmation did not help: a neighbour found the same look-alike. A fit as firm as
+  // MapMatchConfig::far_fit_min_inlier_ratio / _constraint stands: the prior was wrong.
   PoseSearchConfig prior = config.registration.search;
   if (prior.prior_sigma_xy_m > 0 && prior.prior_sigma_yaw_deg > 0) {
     prior.prior_sigma_xy_m = std::max(prior.prior_sigma_xy_m, kGateFloorM);
     prior.prior_sigma_yaw_deg = std::max(prior.prior_sigma_yaw_deg, kGateFloorDeg);
     // prior_weight is exp(−½ χ²).
     const double chi2 = -2 * std::log(prior_weight(prior, initial, out.result.transform));
-    if (chi2 > kChi2Of3Dof99) {
+    const bool firm = out.result.inlier_ratio >= config.far_fit_min_inlier_ratio &&
+                      out.result.weakest_constraint >= config.far_fit_min_constraint;
+    if (chi2 > kChi2Of3Dof99 && !firm) {
       char why[200];
       std::snprintf(why, sizeof why,
                     "the match moved the scan %.2f m and %.2f°, %.1fσ from where its odometry "

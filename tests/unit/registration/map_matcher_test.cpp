@@ -81,9 +81,10 @@ TEST_F(MapMatcher, ACorrectionLargerThanTheSensorsCanErrIsNotApplied) {
 }
 
 // Told how far off the pose it starts from may be (the odometry's σ), the match refuses a fit
-// outside that prior's 99 % ellipsoid: where the odometry cannot be that wrong, it is a
-// look-alike. The same correction within the prior is applied.
-TEST_F(MapMatcher, AFitFarOutsideTheOdometrysPriorIsNotApplied) {
+// outside that prior's 99 % ellipsoid where the fit is no firmer than a look-alike: the odometry
+// cannot be that wrong. The same correction within the prior is applied, and so is a fit beyond
+// it that holds as much of the scan as no look-alike did (the prior was wrong).
+TEST_F(MapMatcher, AFitFarOutsideTheOdometrysPriorIsNotAppliedUnlessFirm) {
   Pose reported = truth_;
   reported.x += 2.0;
   reported.y -= 1.0;
@@ -92,12 +93,20 @@ TEST_F(MapMatcher, AFitFarOutsideTheOdometrysPriorIsNotApplied) {
     c.registration.search.prior_sigma_xy_m = sigma_m;
     c.registration.search.prior_sigma_yaw_deg = 2.0;
     const MapMatch m = match_to_map(map_, scan_, reported, c);
-    if (sigma_m < 1) {  // 2.2 m is 5.6σ
-      EXPECT_FALSE(m.applied);
-      EXPECT_NE(m.result.message.find("look-alike"), std::string::npos) << m.result.message;
-    } else {  // 1.5σ
-      ASSERT_TRUE(m.applied) << m.result.message;
-      EXPECT_LT(metres_between(m.placed, truth_), 0.03);
+    ASSERT_TRUE(m.applied) << m.result.message;
+    EXPECT_LT(metres_between(m.placed, truth_), 0.03);
+    if (sigma_m > 1) continue;  // 1.5σ
+    // 2.2 m is 5.6σ: applied for its firmness alone (most of the yard is on the map).
+    EXPECT_GE(m.result.inlier_ratio, c.far_fit_min_inlier_ratio);
+    EXPECT_GE(m.result.weakest_constraint, c.far_fit_min_constraint);
+    // Asked for more of the scan on the map than it has, or firmer walls, it is a look-alike.
+    for (const bool by_inliers : {true, false}) {
+      MapMatchConfig strict = c;
+      (by_inliers ? strict.far_fit_min_inlier_ratio : strict.far_fit_min_constraint) = 1e3;
+      const MapMatch refused = match_to_map(map_, scan_, reported, strict);
+      EXPECT_FALSE(refused.applied);
+      EXPECT_NE(refused.result.message.find("look-alike"), std::string::npos)
+          << refused.result.message;
     }
   }
 }

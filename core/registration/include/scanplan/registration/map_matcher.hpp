@@ -37,6 +37,16 @@ struct MapMatchConfig {
   // sensors are not that wrong (DESIGN.md: σ 1 m, 5°), so it would be a false match.
   double max_correction_m = 6.0;
   double max_correction_deg = 25.0;
+  // A fit outside the 99 % ellipsoid of the odometry prior is a look-alike (match_to_map) unless
+  // the scan lies on the map as firmly as no look-alike did: this share of its points on the
+  // map and walls pinning it this well (AlignmentQuality::weakest_constraint). The look-alikes
+  // that gate was set by had 7.7–8.6 % inliers; over the campus loops (4,000 matches, 2026-12-04)
+  // no fit metres off passed the sanity check with a quarter of its points on the map, while the
+  // gate refused 17 right ones at 3.4–8σ, 36–58 % inliers and a weakest constraint of 0.07–0.19
+  // but two: the odometry prior had taken the planner's path, and the robot drove round a
+  // platform the map showed a ramp onto (88 m for 23 m planned).
+  double far_fit_min_inlier_ratio = 0.25;
+  double far_fit_min_constraint = 0.06;
   // A refused match leaves x, y and yaw as reported but sets z by the ground (ground_offset),
   // when that moves it no more than this (3σ of the reported height, DESIGN.md).
   bool level_refused = true;
