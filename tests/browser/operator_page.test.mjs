@@ -82,7 +82,14 @@ test('operator page: map, candidates, approval, growth by WebSocket chunk, recon
     assert.match(detail, /drive\s+[\d.]+ m/);
     assert.match(detail, /position\s+-?[\d.]+, -?[\d.]+, -?[\d.]+ m/);
     assert.match(detail, /score F\s+[\d,]+ m²/);
-    assert.match(await page.locator('#cand-list .cand-row').first().innerText(), /≈ [\d,]+ m²\s+new ground · F [\d,]+\s+[\d.]+ m/);
+    // The row warns (⚠) exactly when the planner forecasts the scan there may not match.
+    const firstRow = await page.locator('#cand-list .cand-row').first().innerText();
+    assert.match(firstRow, /≈ [\d,]+ m²\s+(⚠ )?new ground · F [\d,]+\s+[\d.]+ m/);
+    const firstDoubtful = await page.evaluate(() => {
+      const r = window.scanplan.candidates.list[0].registrability;
+      return !!r && r.factor < 1;
+    });
+    assert.equal(firstRow.includes('⚠'), firstDoubtful, 'the warning follows the forecast');
     // The planner's forecast of matching a scan there (matching is on).
     assert.match(detail, /overlap\s+[\d,]+ m² of the map in view/);
     assert.match(detail, /matching\s+(only )?\d+ % (of the scan )?on the trusted map/);
