@@ -43,8 +43,13 @@ namespace {
 
 json match_json(const std::optional<StoredMatch>& m) {
   if (!m) return nullptr;
-  return {{"applied", m->applied}, {"converged", m->converged}, {"method", m->method},
-          {"reason", m->reason},   {"time_ms", m->time_ms},     {"inlier_ratio", m->inlier_ratio}};
+  return {{"applied", m->applied},
+          {"converged", m->converged},
+          {"method", m->method},
+          {"reason", m->reason},
+          {"time_ms", m->time_ms},
+          {"inlier_ratio", m->inlier_ratio},
+          {"weakest_constraint", m->weakest_constraint}};
 }
 
 }  // namespace

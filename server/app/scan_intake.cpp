@@ -145,7 +145,7 @@ StoredScan ScanIntake::match(StoredScan scan, const PointCloud& cloud) {
   scan.match = StoredMatch{m.applied,        m.result.converged,
                            m.result.method,  m.applied ? std::string() : m.result.message,
                            m.result.time_ms, m.result.inlier_ratio,
-                           m.information};
+                           m.information,    m.result.weakest_constraint};
   // Refused, the match leaves the scan at its reported pose carried into the map frame.
   scan.placed = p;
   try {

@@ -110,7 +110,7 @@ const std::string kScanSelect =
     std::string("SELECT ") + kScanColumns +
     ", applied, converged, method, matches.reason, time_ms, inlier_ratio, "
     "ex.excluded, ex.actor, ex.reason, ex.at, matches.information, goal_x, goal_y, goal_z, "
-    "goal_drive_m "
+    "goal_drive_m, matches.weakest_constraint "
     "FROM "
     "scans "
     "LEFT JOIN matches "
@@ -165,6 +165,7 @@ StoredScan scan_from_row(const Statement& s) {
   if (!s.null(29) && !s.null(30) && !s.null(31))
     r.goal = Eigen::Vector3d(s.real(29), s.real(30), s.real(31));
   if (r.goal && !s.null(32)) r.goal_drive_m = s.real(32);
+  if (r.match && !s.null(33)) r.match->weakest_constraint = s.real(33);
   return r;
 }
 
@@ -260,6 +261,9 @@ SessionStore::SessionStore(std::filesystem::path dir) : dir_(created(std::move(d
   // Sessions recorded before the pose graph have no information column.
   if (!has_column("matches", "information"))
     exec("ALTER TABLE matches ADD COLUMN information TEXT");
+  // Nor how firmly the match fixed the pose.
+  if (!has_column("matches", "weakest_constraint"))
+    exec("ALTER TABLE matches ADD COLUMN weakest_constraint REAL");
   // Nor where the robot was sent for each scan (NULL: it was not, or not known).
   for (const char* column : {"goal_x", "goal_y", "goal_z", "goal_drive_m"}) {
     if (!has_column("scans", column))
@@ -405,10 +409,11 @@ void SessionStore::record_match(std::int64_t id, const StoredMatch& m, const Pos
   try {
     Statement ins(db_,
                   "INSERT OR REPLACE INTO matches(scan_id, applied, converged, method, reason, "
-                  "time_ms, inlier_ratio, information) VALUES(?,?,?,?,?,?,?,?)");
+                  "time_ms, inlier_ratio, information, weakest_constraint) "
+                  "VALUES(?,?,?,?,?,?,?,?,?)");
     ins.bind(1, id).bind(2, std::int64_t{m.applied}).bind(3, std::int64_t{m.converged});
     ins.bind(4, m.method).bind(5, m.reason).bind(6, m.time_ms).bind(7, m.inlier_ratio);
-    ins.bind(8, information_text(m.information));
+    ins.bind(8, information_text(m.information)).bind(9, m.weakest_constraint);
     ins.step();
     Statement s(db_,
                 "UPDATE scans SET x = ?, y = ?, z = ?, roll = ?, pitch = ?, yaw = ? WHERE id = ?");

@@ -35,6 +35,10 @@ struct StoredMatch {
   // graph weighs the match by it when the session is brought back. Zero in sessions recorded
   // before the graph (such a match ties its scan in only weakly).
   Eigen::Matrix4d information = Eigen::Matrix4d::Zero();
+  // AlignmentQuality::weakest_constraint of the result: how firmly the matched surfaces fix the
+  // pose in its least fixed direction (a corridor is near 0). Zero in sessions recorded before
+  // it was kept.
+  double weakest_constraint = 0;
 };
 
 // A scan's pose as one revision of the pose graph left it (issue 17): in the map frame, and

@@ -80,6 +80,9 @@ test('acknowledged scans survive SIGKILL', async () => {
     assert.equal(s.match.method, 'search-gicp');
     assert.equal(typeof s.match.applied, 'boolean');
     assert.equal(s.match.reason === '', s.match.applied, 'a reason exactly when not applied');
+    // How firmly the matched surfaces fixed the pose (an applied match passed the check on it).
+    assert.equal(typeof s.match.weakest_constraint, 'number');
+    if (s.match.applied) assert.ok(s.match.weakest_constraint >= 0.01, `${s.match.weakest_constraint}`);
   }
   // Annotations: one withdrawn, and one acknowledged just before the kill.
   const annotate = async (body) => {

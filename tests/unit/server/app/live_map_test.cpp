@@ -39,8 +39,9 @@ class LiveMapGraphTest : public ::testing::Test {
     s.points = cloud.size();
     if (match) {
       if (const auto m = map_.place(cloud, reported, s.robot)) {
-        s.match = StoredMatch{m->applied, m->result.converged, m->result.method, "", 0,
-                              0,          m->information};
+        s.match = StoredMatch{
+            m->applied, m->result.converged,    m->result.method, "",
+            0,          m->result.inlier_ratio, m->information,   m->result.weakest_constraint};
         s.placed = m->placed;
       }
     }

@@ -98,8 +98,9 @@ TEST_F(SessionDir, MatchOutcomesAndPlacementsSurviveReopening) {
   EXPECT_EQ(s.scan(2)->match->inlier_ratio, 0.31);
 }
 
-// The pose graph weighs a match by its information when the session is brought back, and every
-// revision of the poses it made is kept, the latest per scan read back.
+// The pose graph weighs a match by its information when the session is brought back (and
+// /api/v1/scans says how firmly it fixed the pose), and every revision of the poses it made is
+// kept, the latest per scan read back.
 TEST_F(SessionDir, MatchInformationAndPoseRevisionsSurviveReopening) {
   Pose est, first, second;
   first.x = 2.5;
@@ -115,6 +116,7 @@ TEST_F(SessionDir, MatchInformationAndPoseRevisionsSurviveReopening) {
     s.add_scan("robot1", est, est, 2, cloud_of(10, 0));
     StoredMatch m{true, true, "search-gicp", "", 50, 0.4};
     m.information = information;
+    m.weakest_constraint = 0.0731;
     s.record_match(2, m, first);
     EXPECT_EQ(s.record_pose_revision({{2, first, false}}), 1);
     EXPECT_EQ(s.record_pose_revision({{1, est, true}, {2, second, true}}), 2);
@@ -122,6 +124,7 @@ TEST_F(SessionDir, MatchInformationAndPoseRevisionsSurviveReopening) {
   SessionStore s(dir_);
   ASSERT_TRUE(s.scan(2)->match);
   EXPECT_EQ(s.scan(2)->match->information, information) << "to the last bit";
+  EXPECT_EQ(s.scan(2)->match->weakest_constraint, 0.0731);
   EXPECT_EQ(s.scan(2)->placed.x, 2.5) << "the match's own placement stays the evidence";
   EXPECT_EQ(s.pose_revision(), 2);
   const auto latest = s.latest_poses();
@@ -157,6 +160,7 @@ TEST_F(SessionDir, ASessionFromBeforeTheGraphOpensAndGainsTheNewColumns) {
   ASSERT_TRUE(old && old->match);
   EXPECT_DOUBLE_EQ(old->placed.x, 1.1);
   EXPECT_EQ(old->match->information, Eigen::Matrix4d::Zero()) << "not recorded then";
+  EXPECT_EQ(old->match->weakest_constraint, 0.0);
   EXPECT_FALSE(old->goal);
   Pose est;
   EXPECT_EQ(s.add_scan("r", est, est, 8, cloud_of(10, 0), Eigen::Vector3d(3, 4, 5)).id, 2);
