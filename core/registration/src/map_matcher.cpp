@@ -105,8 +105,9 @@ MapMatch match_to_map(const PointCloud& map_points, const PointCloud& scan, cons
     prior.prior_sigma_yaw_deg = std::max(prior.prior_sigma_yaw_deg, kGateFloorDeg);
     // prior_weight is exp(−½ χ²).
     const double chi2 = -2 * std::log(prior_weight(prior, initial, out.result.transform));
-    if (chi2 > kChi2Of3Dof99 &&
-        !config.firm(out.result.inlier_ratio, out.result.weakest_constraint)) {
+    const bool firm = out.result.inlier_ratio >= config.far_fit_min_inlier_ratio &&
+                      out.result.weakest_constraint >= config.far_fit_min_constraint;
+    if (chi2 > kChi2Of3Dof99 && !firm) {
       char why[200];
       std::snprintf(why, sizeof why,
                     "the match moved the scan %.2f m and %.2f°, %.1fσ from where its odometry "

@@ -47,10 +47,6 @@ struct MapMatchConfig {
   // platform the map showed a ramp onto (88 m for 23 m planned).
   double far_fit_min_inlier_ratio = 0.25;
   double far_fit_min_constraint = 0.06;
-  // Whether a result lies on the map as firmly as no look-alike did (far_fit_min_*).
-  bool firm(double inlier_ratio, double weakest_constraint) const {
-    return inlier_ratio >= far_fit_min_inlier_ratio && weakest_constraint >= far_fit_min_constraint;
-  }
   // A refused match leaves x, y and yaw as reported but sets z by the ground (ground_offset),
   // when that moves it no more than this (3σ of the reported height, DESIGN.md).
   bool level_refused = true;
