@@ -15,6 +15,7 @@ import { GoalPicker } from './goals.js';
 import { DecisionLog } from './log.js';
 import { MapChunks } from './map_chunks.js';
 import { Markers } from './markers.js';
+import { ScanInFlight } from './scan_in_flight.js';
 import { MeasureTool } from './measure.js';
 import { setRobotIds } from './robot_colors.js';
 import { MissionPanel } from './mission.js';
@@ -70,6 +71,18 @@ const chunks = new MapChunks({
     render();
   },
   onChange: () => render(),
+});
+// The candidates the operator waits for come first: while the server works on a scan the view
+// draws only when the camera moves and new chunks wait to be decoded (scan_in_flight.js).
+const inFlight = new ScanInFlight({
+  onBusy: () => {
+    view?.pause();
+    chunks.pause();
+  },
+  onIdle: () => {
+    view?.resume();
+    chunks.resume();
+  },
 });
 new ExportMenu($('export-select'), $('export-msg'));
 
@@ -450,6 +463,13 @@ function soon(fn, ms = 300) {
   scansTimer = setTimeout(fn, ms);
 }
 
+// The latest refresh of the candidates a plan_done asked for: the view draws again only once the
+// operator can see them (after their next frame).
+let candidatesShown = Promise.resolve();
+function afterCandidates(fn) {
+  candidatesShown.finally(() => requestAnimationFrame(() => setTimeout(fn, 0)));
+}
+
 function onEvent(e) {
   switch (e.type) {
     case 'scan_progress':
@@ -460,6 +480,7 @@ function onEvent(e) {
       updateRobot();
       break;
     case 'scan_received':
+      inFlight.received(e.scan);
       mission.onScanReceived(e);
       break;
     case 'match_done':
@@ -486,6 +507,7 @@ function onEvent(e) {
       });
       break;
     case 'map_updated':
+      afterCandidates(() => inFlight.settled(e.scan));
       chunks.outdated();
       mission.onMapUpdated(e);
       chart.set(e.scan, e);
@@ -496,7 +518,8 @@ function onEvent(e) {
       });
       break;
     case 'plan_done':
-      refreshCandidates();
+      candidatesShown = refreshCandidates();
+      afterCandidates(() => inFlight.settled(e.based_on_scan));
       refreshLayer();
       // The mission's progress line (the best candidate's gain, the estimate) follows the plan.
       refreshSession();
@@ -556,6 +579,7 @@ function onStreamState(s, info) {
   } else if (s === 'lost' && was === 'open') {
     state.heldAtLoss = chunks.held.size;
   }
+  if (s !== 'open') inFlight.clear();
   render();
 }
 

@@ -33,6 +33,21 @@ export class MapChunks {
     this.worker = null;
     this.jobs = new Map(); // key -> {resolve, reject}
     this.nextKey = 1;
+    this.gate = null; // while paused: {promise, open}; decoding waits for it
+  }
+
+  /** Chunks that arrive wait to be decoded until resume() (they are counted as pending). */
+  pause() {
+    if (this.gate) return;
+    let open;
+    const promise = new Promise((resolve) => (open = resolve));
+    this.gate = { promise, open };
+  }
+
+  resume() {
+    const gate = this.gate;
+    this.gate = null;
+    gate?.open();
   }
 
   _worker() {
@@ -100,6 +115,7 @@ export class MapChunks {
     this.pending.add(id);
     this.onChange();
     try {
+      while (this.gate) await this.gate.promise;
       const d = await this._decode(buffer, id);
       this.pending.delete(id);
       // Drawn all the same (nearer than nothing), and fetched again where it now is.

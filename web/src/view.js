@@ -162,6 +162,7 @@ export class MapView {
     this._fraction = 1; // the fraction of every chunk a frame draws (_applyLod)
     this.fill = null; // {done}: at rest, the fraction drawn so far by the fill passes
     this._extended = false; // the draw ranges reach past _fraction (what the fill drew)
+    this.paused = false; // at rest nothing is drawn (pause): the server needs the CPU
     this.onClick = null; // (event, pick) for tools
     this.afterRender = null; // called after each drawn frame (the markers declutter their labels)
     this.onLodChange = null;
@@ -195,6 +196,15 @@ export class MapView {
 
   requestRender() {
     this.dirty = true;
+  }
+
+  /** Draws only while the camera moves, until resume(); what changed meanwhile is drawn then. */
+  pause() {
+    this.paused = true;
+  }
+
+  resume() {
+    this.paused = false;
   }
 
   resize() {
@@ -489,6 +499,7 @@ export class MapView {
     const now = performance.now();
     this._timeFrame(now);
     const moving = this.controls.update();
+    if (this.paused && !moving && !this.interacting) return;
     if (moving || this.dirty) {
       this.dirty = false;
       // A new frame starts from the capped share; what a fill drew is drawn again by a new fill.
