@@ -184,16 +184,17 @@ LiveMap::Followed LiveMap::follow_mission(std::vector<StoredScan> scans,
                                           std::vector<std::shared_ptr<const PointCloud>> placed,
                                           std::vector<std::uint8_t> in_map) const {
   Followed f;
-  const MissionConfig& config = mission_.config();
   const std::size_t newest = scans.size() - 1;
   for (std::size_t i = 0; i < scans.size(); ++i) {
     const Pose& now = mission_.poses()[i];
     const bool now_in = mission_.in_map(i);
     const bool was_in = in_map[i] != 0;
-    const PoseChange d = change(scans[i].placed, now);
-    const bool moved = d.metres > config.replace_m || d.degrees > config.replace_deg;
+    // The pipeline makes a scan's points anew only when the graph moved it past replace_m /
+    // _deg (MissionPipeline::placed_scans): the map shows the same cloud, never a copy of it.
+    const bool moved = placed[i] != mission_.placed_scans()[i];
+    const PoseChange d = change(scans[i].placed, mission_.cloud_poses()[i]);
     if (moved) {
-      scans[i].placed = now;
+      scans[i].placed = mission_.cloud_poses()[i];
       placed[i] = mission_.placed_scans()[i];
       f.unencoded.push_back(scans[i].id);
     }
@@ -596,7 +597,7 @@ LiveMap::Rebuilt LiveMap::rebuild(const std::vector<StoredScan>& keep, const Sca
   std::map<std::int64_t, std::shared_ptr<const std::string>> chunks;
   for (std::size_t i = 0; i < scans.size(); ++i) {
     StoredScan& s = scans[i];
-    s.placed = mission_.poses()[i];
+    s.placed = mission_.cloud_poses()[i];
     f.placed.push_back(mission_.placed_scans()[i]);
     f.in_map.push_back(mission_.in_map(i) ? 1 : 0);
     f.bounds.push_back(bounds_of(*f.placed.back()));

@@ -145,8 +145,9 @@ SurfaceDistance surface_distance(const MissionPipeline& mission, double max_apar
   }
   std::vector<PointCloud> target(mission.poses().size()), source(mission.poses().size());
   for (const std::size_t i : in_map) {
-    target[i] = voxel_downsample(*mission.placed_scans()[i], kTargetVoxelM);
-    source[i] = voxel_downsample(*mission.placed_scans()[i], kSourceVoxelM);
+    const PointCloud at = mission.at_estimate(i);
+    target[i] = voxel_downsample(at, kTargetVoxelM);
+    source[i] = voxel_downsample(at, kSourceVoxelM);
   }
   constexpr std::size_t kMinWallPoints = 100;
   SurfaceDistance out;

@@ -178,6 +178,44 @@ TEST_F(MissionPipelineTest, TheGraphPlacesAScanTheMapMatchRefused) {
   EXPECT_LT((mission.placed_scans()[1]->points[0] - moved).norm(), 1e-3);
 }
 
+// The owner (the server's live map) shares each scan's cloud and shows it until the scan moves
+// past replace_m / _deg; the pipeline makes no copy for a smaller move, and uses the points where
+// the graph has the scan all the same.
+TEST_F(MissionPipelineTest, AScanMovedLessThanReplaceKeepsItsCloudButIsUsedWhereTheGraphHasIt) {
+  MissionConfig c = config();
+  c.replace_m = 10;  // the 2.8 m correction below stays under it
+  c.replace_deg = 90;
+  MissionPipeline mission(c);
+  mission.add(scan_at(at(-15, -8, 0), 1), {at(-15, -8, 0), at(-15, -8, 0)});
+  const Pose refused_at = at(-3, -7, 0);
+  const PointCloud second = scan_at(at(-5, -9, 0), 2);
+  const auto cloud = mission.add(second, {refused_at, refused_at});
+  const Pose third = at(-12, 4, 30);
+  const PointCloud third_scan = scan_at(third, 3);
+  const auto m = mission.place(third_scan, third);
+  ASSERT_TRUE(m && m->applied);
+  Placement matched(third, m->placed, true);
+  matched.information = m->information;
+  mission.add(third_scan, matched);
+  ASSERT_TRUE(mission.in_map(1));
+  EXPECT_NEAR(mission.poses()[1].x, -5, 0.03);
+
+  EXPECT_EQ(mission.placed_scans()[1], cloud) << "the same cloud, not a copy";
+  EXPECT_NEAR(mission.cloud_poses()[1].x, refused_at.x, 1e-9);
+  const Eigen::Vector3f truth = mission.poses()[1].isometry().cast<float>() * second.points[0];
+  EXPECT_LT((mission.at_estimate(1).points[0] - truth).norm(), 1e-3);
+  // The map's points near it, as a match takes them, lie where the graph has the scan.
+  Viewpoints views;
+  const PointCloud near = mission.points_near(-5, -9, 1.5, false, &views);
+  ASSERT_FALSE(near.empty());
+  std::size_t of_second = 0;
+  for (std::size_t i = 0; i < near.size(); ++i) {
+    const Eigen::Vector3f& origin = views.origins[views.origin_of[i]];
+    if ((origin.head<2>() - Eigen::Vector2f(-5, -9)).norm() < 0.05F) ++of_second;
+  }
+  EXPECT_GT(of_second, 0u) << "the second scan's points and scanner at its estimate";
+}
+
 // A scan nothing ties in stays out of the MLS map (no phantom walls for the planner) but is
 // kept, and its points go where the graph has it.
 TEST_F(MissionPipelineTest, AScanNothingTiesInStaysOutOfTheMap) {

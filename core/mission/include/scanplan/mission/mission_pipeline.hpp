@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -143,8 +144,12 @@ class MissionPipeline {
   // What the graph did after the latest scan; nothing with the graph off.
   const std::optional<MapCorrection>& last_correction() const { return last_correction_; }
   const ScanGraph* graph() const { return graph_ ? &*graph_ : nullptr; }
-  // Each scan's points in the map frame, in the order they joined.
+  // Each scan's points in the map frame, in the order they joined, at cloud_poses(): the
+  // graph's estimate (poses()) moves them anew only past MissionConfig::replace_m / _deg.
   const std::vector<std::shared_ptr<const PointCloud>>& placed_scans() const { return placed_; }
+  const std::vector<Pose>& cloud_poses() const { return cloud_poses_; }
+  // The i-th scan's points at the graph's estimate (a copy).
+  PointCloud at_estimate(std::size_t i) const;
   const MappingPipeline& mapping() const { return mapping_; }
   // The map of the anchored scans (with the graph on, mapping()'s); nothing when matching is
   // off.
@@ -203,6 +208,8 @@ class MissionPipeline {
   bool unsure(const Placement& where) const;
   bool beyond_reach(const MoveUncertainty& u) const;
   void follow_graph();
+  bool cloud_lags(std::size_t i) const;
+  Eigen::Affine3f lag_of(std::size_t i) const;
   void join_map(const PointCloud& own, std::size_t i);
   PointCloud own_frame(std::size_t i) const;
   bool reaches(std::size_t i, double x, double y, double radius_m) const;
