@@ -26,6 +26,17 @@ class MissionPipelineTest : public ::testing::Test {
   static PointCloud scan_at(const Pose& truth, std::uint64_t seed) {
     return simulate_scan(*caster_, world_->scanner, truth, seed);
   }
+  // A scan taken at `truth`, placed by its match to the map (reported at the truth): whether
+  // the match was applied.
+  static bool add_matched(MissionPipeline& mission, const Pose& truth, std::uint64_t seed) {
+    const PointCloud scan = scan_at(truth, seed);
+    const auto m = mission.place(scan, truth);
+    if (!m || !m->applied) return false;
+    Placement matched(truth, m->placed, true);
+    matched.information = m->information;
+    mission.add(scan, matched);
+    return true;
+  }
   static MissionConfig config() {
     MissionConfig c;
     c.mapping.sensor_height_m = world_->scanner.mount_height_m;
@@ -158,13 +169,7 @@ TEST_F(MissionPipelineTest, TheGraphPlacesAScanTheMapMatchRefused) {
   EXPECT_EQ(mission.last_correction()->graph.pairs_matched, 1u);
 
   // A third scan, placed by the map match, agrees on where the second lies.
-  const Pose third = at(-12, 4, 30);
-  const PointCloud third_scan = scan_at(third, 3);
-  const auto m = mission.place(third_scan, third);
-  ASSERT_TRUE(m && m->applied);
-  Placement matched(third, m->placed, true);
-  matched.information = m->information;
-  mission.add(third_scan, matched);
+  ASSERT_TRUE(add_matched(mission, at(-12, 4, 30), 3));
   EXPECT_TRUE(mission.anchored(1));
   EXPECT_TRUE(mission.in_map(1));
   EXPECT_NEAR(mission.poses()[1].x, -5, 0.03);
@@ -190,13 +195,7 @@ TEST_F(MissionPipelineTest, AScanMovedLessThanReplaceKeepsItsCloudButIsUsedWhere
   const Pose refused_at = at(-3, -7, 0);
   const PointCloud second = scan_at(at(-5, -9, 0), 2);
   const auto cloud = mission.add(second, {refused_at, refused_at});
-  const Pose third = at(-12, 4, 30);
-  const PointCloud third_scan = scan_at(third, 3);
-  const auto m = mission.place(third_scan, third);
-  ASSERT_TRUE(m && m->applied);
-  Placement matched(third, m->placed, true);
-  matched.information = m->information;
-  mission.add(third_scan, matched);
+  ASSERT_TRUE(add_matched(mission, at(-12, 4, 30), 3));
   ASSERT_TRUE(mission.in_map(1));
   EXPECT_NEAR(mission.poses()[1].x, -5, 0.03);
 
