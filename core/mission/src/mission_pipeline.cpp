@@ -326,7 +326,7 @@ void MissionPipeline::follow_graph() {
   }
   // The points shown follow the graph wherever the scan is, in the map or not.
   for (std::size_t i = 0; i < placed_.size(); ++i) {
-    if (cloud_lags(i)) set_cloud(i, to_map_frame(own_frame(i), poses_[i]));
+    if (cloud_lags(i)) set_cloud(i, std::make_shared<const PointCloud>(at_estimate(i)));
   }
 }
 
