@@ -111,7 +111,7 @@ std::optional<MapMatch> LiveMap::place(const PointCloud& scan, const Pose& repor
   std::optional<MissionPipeline::MatchInput> in;
   {
     std::lock_guard encode_lock(encode_mutex_);
-    in = mission_.match_input(reported, robot, driven_m);
+    in = mission_.match_input(scan, reported, robot, driven_m);
   }
   if (!in) return std::nullopt;
   return match_to_map(in->map_points, scan, in->prior, in->config, in->views);

@@ -53,6 +53,14 @@ PipelineConfig with_planner_thresholds(PipelineConfig mapping, const PlannerConf
   return mapping;
 }
 
+// The map match's configuration for `scan`: its lengths sized by the scan once, here, so that
+// the map's points can be gathered as thinly as the match will use them (points_of).
+MapMatchConfig sized_for(MapMatchConfig config, const PointCloud& scan) {
+  config.registration = adapted_config(scan, config.registration);
+  config.registration.adapt_to_scene = false;
+  return config;
+}
+
 }  // namespace
 
 MissionPipeline::MissionPipeline(MissionConfig config)
@@ -82,7 +90,8 @@ bool MissionPipeline::has_map() const {
   return mapping_.regions() && mapping_.movable() && mapping_.target();
 }
 
-std::optional<MissionPipeline::MatchInput> MissionPipeline::match_input(const Pose& reported,
+std::optional<MissionPipeline::MatchInput> MissionPipeline::match_input(const PointCloud& scan,
+                                                                        const Pose& reported,
                                                                         const std::string& track,
                                                                         double driven_m) const {
   if (!config_.matching || placed_.empty()) return std::nullopt;
@@ -93,15 +102,16 @@ std::optional<MissionPipeline::MatchInput> MissionPipeline::match_input(const Po
       config = widened(config, *prior);
     }
   }
-  MatchInput in{{}, config, start, {{}, scanner_view()}};
-  in.map_points = points_of(match_sources(start.x, start.y, config.target_radius_m), start.x,
-                            start.y, config.target_radius_m, &in.views.target);
+  MatchInput in{{}, sized_for(config, scan), start, {{}, scanner_view()}};
+  in.map_points =
+      points_of(match_sources(start.x, start.y, config.target_radius_m), start.x, start.y,
+                config.target_radius_m, &in.views.target, in.config.registration.voxel_m);
   return in;
 }
 
 std::optional<MapMatch> MissionPipeline::place(const PointCloud& scan, const Pose& reported,
                                                const std::string& track, double driven_m) const {
-  const std::optional<MatchInput> in = match_input(reported, track, driven_m);
+  const std::optional<MatchInput> in = match_input(scan, reported, track, driven_m);
   if (!in) return std::nullopt;
   return match_to_map(in->map_points, scan, in->prior, in->config, in->views);
 }
@@ -267,10 +277,12 @@ bool MissionPipeline::rematch_refused(GraphUpdate& update) {
       [&](std::size_t r) { return graph_->uncertainty(retries[r].scan); },
       [&](std::size_t r, const MoveUncertainty& uncertain) {
         const Pose& at = poses_[retries[r].scan];
+        const PointCloud& scan = graph_->thinned(retries[r].scan);
+        const MapMatchConfig config = sized_for(widened(*config_.matching, uncertain), scan);
         MatchViews views{{}, scanner_view()};
-        const PointCloud around = points_of(retries[r].sources, at.x, at.y, radius, &views.target);
-        return match_to_map(around, graph_->thinned(retries[r].scan), level(at),
-                            widened(*config_.matching, uncertain), views);
+        const PointCloud around = points_of(retries[r].sources, at.x, at.y, radius, &views.target,
+                                            config.registration.voxel_m);
+        return match_to_map(around, scan, level(at), config, views);
       },
       [&](std::size_t r, const MapMatch& m) {
         const std::size_t u = retries[r].scan;
@@ -500,32 +512,48 @@ std::vector<std::size_t> MissionPipeline::match_sources(double x, double y, doub
   return out;
 }
 
+// With `thinned_to_m`, the voxel the caller's match thins the map to: a scan the graph keeps
+// thinned to no coarser than that is read from there (ScanGraph::thinned, a fraction of its
+// points), the rest at full resolution. On a long session the gathering, cropping and
+// thinning of millions of map points had taken 0.5–0.9 s of every match (issue 19).
 PointCloud MissionPipeline::points_of(const std::vector<std::size_t>& scans, double x, double y,
-                                      double radius_m, Viewpoints* views) const {
+                                      double radius_m, Viewpoints* views,
+                                      double thinned_to_m) const {
   PointCloud out;
   if (views) *views = {};
   const Eigen::Vector2f c(static_cast<float>(x), static_cast<float>(y));
   const float r2 = static_cast<float>(radius_m * radius_m);
   const Eigen::Vector3f sensor = scanner_view().origins.front();
-  // Each scan's points at the graph's estimate (its cloud may lag it by up to replace_m).
-  const auto within = [&](const Eigen::Affine3f& lag, const Eigen::Vector3f& p) {
-    const Eigen::Vector2f q = lag.linear().topRows<2>() * p + lag.translation().head<2>();
+  // Each scan's points at the graph's estimate (its cloud may lag it by up to replace_m; the
+  // graph's thinned copy is levelled at the pose the graph has).
+  struct Source {
+    const PointCloud* cloud;
+    Eigen::Affine3f to_map;
+  };
+  const auto source = [&](std::size_t i) -> Source {
+    if (graph_ && thinned_to_m > 0 && graph_->thinned_voxel_m(i) <= thinned_to_m * (1 + 1e-9)) {
+      return {&graph_->thinned(i), Eigen::Affine3f(level(poses_[i]).isometry().cast<float>())};
+    }
+    return {placed_[i].get(), lag_of(i)};
+  };
+  const auto within = [&](const Eigen::Affine3f& to_map, const Eigen::Vector3f& p) {
+    const Eigen::Vector2f q = to_map.linear().topRows<2>() * p + to_map.translation().head<2>();
     return (q - c).squaredNorm() <= r2;
   };
   // Counted first: millions of points on a long session, and a growing vector would copy them
   // over and over and hold twice their memory while it does.
   std::size_t count = 0;
   for (const std::size_t i : scans) {
-    const Eigen::Affine3f lag = lag_of(i);
-    for (const auto& p : placed_[i]->points) count += within(lag, p) ? 1 : 0;
+    const Source s = source(i);
+    for (const auto& p : s.cloud->points) count += within(s.to_map, p) ? 1 : 0;
   }
   out.points.reserve(count);
   if (views) views->origin_of.reserve(count);
   for (const std::size_t i : scans) {
     const std::size_t before = out.size();
-    const Eigen::Affine3f lag = lag_of(i);
-    for (const auto& p : placed_[i]->points) {
-      if (within(lag, p)) out.points.push_back(lag * p);
+    const Source s = source(i);
+    for (const auto& p : s.cloud->points) {
+      if (within(s.to_map, p)) out.points.push_back(s.to_map * p);
     }
     if (views && out.size() > before) {
       views->origins.push_back(poses_[i].isometry().cast<float>() * sensor);

@@ -131,6 +131,7 @@ GraphUpdate ScanGraph::add(const PointCloud& scan, const Placement& where, bool 
   const RegistrationConfig adapted = adapted_config(scan, config_.registration);
   thinned_.push_back(std::make_shared<const PointCloud>(
       levelled(voxel_downsample(scan, adapted.voxel_m), where.placed)));
+  thinned_voxel_.push_back(adapted.voxel_m);
   scanners_.push_back(scanner);
   reported_.push_back(where.reported);
   driven_.push_back(where.driven_m);
@@ -161,7 +162,7 @@ GraphUpdate ScanGraph::add(const PointCloud& scan, const Placement& where, bool 
 }
 
 // Whether `b` placed at `b_placed` lies where the robot's odometry puts it from `a` placed at
-// `a_placed`, within three of the move's σ (at least 0.5 m and 1°).
+// `a_placed`, within three of the move's σ (at least 0.5 m and 1°, at most 5 m and 10°).
 bool ScanGraph::odometry_agrees(std::size_t a, const Pose& a_placed, std::size_t b,
                                 const Pose& b_placed) const {
   const RelativePose move = relative_pose(reported_[a], reported_[b]);
@@ -169,10 +170,13 @@ bool ScanGraph::odometry_agrees(std::size_t a, const Pose& a_placed, std::size_t
   const MoveUncertainty u = odometry_uncertainty(move, previous_[b] == a ? driven_[b] : 0.0);
   const double off_m = std::hypot(predicted.x - b_placed.x, predicted.y - b_placed.y);
   const double off_deg = std::abs(rad2deg(std::remainder(predicted.yaw - b_placed.yaw, 2 * M_PI)));
-  // Never looser than a few metres: a look-alike lies a building's depth off, and a long drive's
-  // own error must not hide that.
-  return off_m <= std::clamp(3 * std::sqrt(2.0) * u.xy_m, 0.5, 3.0) &&
-         off_deg <= std::clamp(3 * u.yaw_deg, 1.0, 3.0);
+  // Never looser than a few metres: a look-alike lies a building's depth off (16 m on the
+  // campus), and a long drive's own error must not hide that. A look-alike is a shift, not a
+  // turn of a few degrees; the heading may be as far off as the drive says, short of a turn that
+  // would make a different structure match: on the campus loop, correct pairs of matches 50–60 m
+  // apart were 0.7–3.4 m and 3.2–4.1° off their odometry, and a 3 m / 3° bound kept them out.
+  return off_m <= std::clamp(3 * std::sqrt(2.0) * u.xy_m, 0.5, 5.0) &&
+         off_deg <= std::clamp(3 * u.yaw_deg, 1.0, 10.0);
 }
 
 // A map match that corrected the pose further than the sensors usually err (the search reached
@@ -221,7 +225,56 @@ void ScanGraph::offer_match_to_map(std::size_t scan, const Pose& placed,
 GraphSolveReport ScanGraph::solve() {
   GraphSolveReport report = graph_.optimise();
   update_anchors(report);
+  if (confirm_waiting(report)) {
+    const double first_ms = report.time_ms;
+    report = graph_.optimise();
+    report.time_ms += first_ms;
+    update_anchors(report);
+  }
   return report;
+}
+
+// Whether pose `a` and `b` of one scan agree as two matches of it must (agree_m / _deg).
+bool ScanGraph::agree(const Pose& a, const Pose& b) const {
+  return std::hypot(a.x - b.x, a.y - b.y, a.z - b.z) <= config_.agree_m &&
+         std::abs(rad2deg(std::remainder(a.yaw - b.yaw, 2 * M_PI))) <= config_.agree_deg;
+}
+
+// A far map match waiting for its robot's next scan (pending_map_) is believed, too, when a
+// pairwise match with a later scan that is in the map now puts it where the map match did. That
+// scan was placed without this one (not in the map), the pair matched their own points, and a
+// look-alike would have to fool both to the centimetre. The odometry to the next scan is far
+// rougher: on the campus loop (drifting odometry) two correct matches 52 m apart were 3.4 m and
+// 3.2° off the odometry between them, and the scan stayed out of the map, metres off.
+bool ScanGraph::later_pair_confirms(std::size_t scan, const GraphEdge& edge) const {
+  const std::size_t other = edge.from == scan ? edge.to : edge.from;
+  return pending_map_[scan] && other > scan && anchored_[other] &&
+         agree(implied(edge, scan), placed_now(scan, *pending_map_[scan]));
+}
+
+// What confirms a waiting map match may come after the scan that could: the robot's next scan
+// tied in by pairs or a re-match (confirm_by_odometry), a pair matched while both ends were
+// outside the map whose later end is in it now (later_pair_confirms).
+bool ScanGraph::confirm_waiting(const GraphSolveReport& solve) {
+  bool any = false;
+  for (std::size_t n = 0; n < graph_.size(); ++n) {
+    const std::size_t p = previous_[n];
+    if (p == kNoNode || !pending_map_[p] || anchored_[p] || !anchored_[n]) continue;
+    confirm_by_odometry(n);
+    any = any || !pending_map_[p];
+  }
+  std::vector<std::uint8_t> outlier(graph_.edges().size(), 0);
+  for (const std::size_t e : solve.outliers) outlier[e] = 1;
+  for (std::size_t e = 0; e < outlier.size(); ++e) {  // believing adds edges, none a pair
+    if (outlier[e] || anchors_[e] != kNoNode || origins_[e] != "pair-search") continue;
+    const GraphEdge edge = graph_.edges()[e];  // a copy: believing adds edges
+    for (const std::size_t scan : {edge.from, edge.to}) {
+      if (anchored_[scan] || !later_pair_confirms(scan, edge)) continue;
+      believe_waiting(scan);
+      any = true;
+    }
+  }
+  return any;
 }
 
 void ScanGraph::add_odometry(std::size_t from, std::size_t to) {
@@ -435,6 +488,11 @@ Pose ScanGraph::implied(const GraphEdge& edge, std::size_t scan) const {
 // face of a building as deep as the search is wide) would otherwise bring a scan into the map
 // metres off, and the map never recovers from a phantom wall. Until then the result waits.
 void ScanGraph::offer(const GraphEdge& edge, std::size_t scan) {
+  if (later_pair_confirms(scan, edge)) {
+    believe_waiting(scan);
+    add_match_edge(edge, "pair-search", scan);
+    return;
+  }
   const Pose there = implied(edge, scan);
   std::vector<GraphEdge>& waiting = pending_[scan];
   std::vector<GraphEdge> agreeing;
@@ -442,11 +500,7 @@ void ScanGraph::offer(const GraphEdge& edge, std::size_t scan) {
     const std::size_t other_end = other.from == scan ? other.to : other.from;
     const std::size_t this_end = edge.from == scan ? edge.to : edge.from;
     if (other_end == this_end) continue;
-    const Pose p = implied(other, scan);
-    if (std::hypot(p.x - there.x, p.y - there.y, p.z - there.z) <= config_.agree_m &&
-        std::abs(rad2deg(std::remainder(p.yaw - there.yaw, 2 * M_PI))) <= config_.agree_deg) {
-      agreeing.push_back(other);
-    }
+    if (agree(implied(other, scan), there)) agreeing.push_back(other);
   }
   if (agreeing.empty()) {
     waiting.push_back(edge);

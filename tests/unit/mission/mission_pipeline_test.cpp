@@ -102,7 +102,7 @@ TEST_F(MissionPipelineTest, OnlyAnchoredScansAreMatchedAgainst) {
   const std::size_t all = mission.points_near(-4, -8, 3).size();
   const std::size_t anchored = mission.points_near(-4, -8, 3, /*anchored_only=*/true).size();
   EXPECT_LT(anchored, all);
-  const auto in = mission.match_input(off);
+  const auto in = mission.match_input(scan_at(at(-5, -9, 0), 3), off);
   ASSERT_TRUE(in);
   EXPECT_EQ(in->map_points.size(),
             mission.points_near(off.x, off.y, in->config.target_radius_m, true).size());
@@ -134,14 +134,14 @@ TEST_F(MissionPipelineTest, APlaceScannedAgainIsMatchedAgainstItsLatestScanOnly)
   mission.add(scan_at(again, 2), {again, again, /*matched=*/true});
   const auto mount = static_cast<float>(without_graph.mapping.sensor_height_m);
   const auto origins = [&](const Pose& from) {
-    const auto in = mission.match_input(from);
+    const auto in = mission.match_input(scan_at(from, 9), from);
     EXPECT_TRUE(in && in->views.target.fit(in->map_points.size()));
     return in ? in->views.target.origins : std::vector<Eigen::Vector3f>{};
   };
   std::vector<Eigen::Vector3f> seen = origins(at(-5, -9, 0));
   ASSERT_EQ(seen.size(), 1u) << "the first scan's place was scanned again half a metre off";
   EXPECT_TRUE(seen[0].isApprox(Eigen::Vector3f(-15.4F, -8.3F, mount), 1e-3F));
-  const auto in = mission.match_input(at(-5, -9, 0));
+  const auto in = mission.match_input(scan_at(at(-5, -9, 0), 9), at(-5, -9, 0));
   const auto within =
       std::count_if(mission.placed_scans()[1]->points.begin(),
                     mission.placed_scans()[1]->points.end(), [&](const Eigen::Vector3f& p) {
@@ -154,6 +154,41 @@ TEST_F(MissionPipelineTest, APlaceScannedAgainIsMatchedAgainstItsLatestScanOnly)
   seen = origins(at(-5, -9, 0));
   ASSERT_EQ(seen.size(), 2u);
   EXPECT_TRUE(seen[1].isApprox(Eigen::Vector3f(-12, -8, mount), 1e-3F));
+}
+
+// With the graph, the map's points are gathered for a match as thinly as the match uses them:
+// from the graph's thinned copy of each scan, at the graph's pose (issue 19: on a long session
+// gathering and thinning millions of points took most of every match).
+TEST_F(MissionPipelineTest, WithTheGraphTheMatchReadsEachScanThinned) {
+  MissionPipeline mission(config());
+  const Pose first = at(-15, -8, 0), second = at(-3, -7, 20);
+  mission.add(scan_at(first, 1), {first, first});
+  ASSERT_TRUE(add_matched(mission, second, 2));
+  const PointCloud scan = scan_at(at(-5, -9, 0), 3);
+  const auto in = mission.match_input(scan, at(-5, -9, 0));
+  ASSERT_TRUE(in);
+  const double r = in->config.target_radius_m;
+  const ScanGraph& graph = *mission.graph();
+  ASSERT_LE(graph.thinned_voxel_m(0), in->config.registration.voxel_m);
+  std::size_t expected = 0;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const Eigen::Isometry3f to_map = level(mission.poses()[i]).isometry().cast<float>();
+    for (const auto& p : graph.thinned(i).points) {
+      const Eigen::Vector3f q = to_map * p;
+      expected += std::hypot(q.x() + 5, q.y() + 9) <= r ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(in->map_points.size(), expected);
+  EXPECT_LT(in->map_points.size(), mission.points_near(-5, -9, r, true).size() / 3);
+  ASSERT_TRUE(in->views.target.fit(in->map_points.size()));
+  EXPECT_EQ(in->views.target.origins.size(), 2u);
+  // The lengths are sized by the scan already: the matcher does not size them again.
+  EXPECT_FALSE(in->config.registration.adapt_to_scene);
+  // And the match from there lands where the full-resolution one does.
+  const MapMatch m = match_to_map(in->map_points, scan, in->prior, in->config, in->views);
+  ASSERT_TRUE(m.applied) << m.result.message;
+  EXPECT_NEAR(m.placed.x, -5, 0.03);
+  EXPECT_NEAR(m.placed.y, -9, 0.03);
 }
 
 // With the graph, a scan the map match refused is matched pairwise with the anchored scans

@@ -2,6 +2,7 @@
 // how sure odometry is, and when a match beyond the sensors' usual reach is believed.
 #include "scanplan/mission/scan_graph.hpp"
 #include "ground_pose.hpp"
+#include "quick_yard.hpp"
 
 #include <gtest/gtest.h>
 
@@ -148,6 +149,73 @@ TEST(ScanGraph, AWaitingScanIsBelievedWhenTheNextScanIsPlacedWhereTheOdometrySay
   graph.add(few_points(), placement(at(160, 0, 0), at(160, 8.3, 0), true));
   EXPECT_TRUE(graph.anchored(2));
   EXPECT_TRUE(graph.anchored(1));
+}
+
+// The heading may be off by as much as the drive says (3σ, up to 10°): a look-alike is a shift
+// of a building's depth, not a turn of a few degrees. On the campus, correct matches 60–80 m
+// apart were 3–4° off their odometry, and a 3° bound kept them out of the map.
+TEST(ScanGraph, AFarCorrectionIsBelievedWhenTheHeadingIsAsFarOffAsTheDriveSays) {
+  for (const double off_deg : {4.0, 11.0}) {
+    ScanGraph graph({}, drift());
+    graph.add(few_points(), placement(at(0, 0, 0), at(0, 0, 0), false));
+    graph.add(few_points(), placement(at(150, 0, 0), at(150, 8, 0), true), /*tentative=*/true);
+    // 60 m on: σ of the heading 0.3° per 10 m over 1.5 × 60 m, 3σ 8.1°.
+    graph.add(few_points(), placement(at(210, 0, 0), at(210, 8, off_deg), true));
+    EXPECT_EQ(graph.anchored(1), off_deg < 8.1) << off_deg << "°";
+  }
+}
+
+// The robot's next scan may be tied in only later (its own match refused when it came): the
+// waiting scan is believed then.
+TEST(ScanGraph, AWaitingScanIsBelievedWhenItsNextScanIsTiedInLater) {
+  ScanGraph graph({}, drift());
+  graph.add(few_points(), placement(at(0, 0, 0), at(0, 0, 0), false));
+  graph.add(few_points(), placement(at(150, 0, 0), at(150, 8, 0), true), /*tentative=*/true);
+  graph.add(few_points(), placement(at(160, 0, 0), at(160, 0, 0), false));
+  ASSERT_FALSE(graph.anchored(1));
+  ASSERT_FALSE(graph.anchored(2));
+  graph.add_match_to_map(2, at(160, 8.3, 0), Eigen::Matrix4d::Identity() * 0.3, "rematch");
+  graph.solve();
+  EXPECT_TRUE(graph.anchored(2));
+  EXPECT_TRUE(graph.anchored(1));
+  EXPECT_NEAR(graph.poses()[1].y, 8, 0.1);
+}
+
+// A pairwise match with a later scan that the map places by itself confirms a waiting map match
+// when the two put the scan in the same place (a look-alike would have to fool a second,
+// independent match to the centimetre), where no odometry relates them. Real scans of the yard:
+// robot 1's scan waits; a second robot's first scan, 6 m away, is refused by the map when it
+// comes and matched later, where the truth is or half a metre off.
+TEST(ScanGraph, AWaitingScanIsBelievedWhenAPairWithALaterScanInTheMapAgrees) {
+  using testing_support::quick_yard_scan;
+  const Pose first = at(-15, -8, 0), truth1 = at(-2, -8, 0), truth2 = at(-2, -14, 0);
+  for (const double map_off_m : {0.0, 0.5}) {
+    ScanGraph graph({}, drift());
+    graph.add(quick_yard_scan(first, 1), placement(first, first, false));
+    // Reported 1 m off; its map match (the truth) waits for confirmation.
+    graph.add(quick_yard_scan(truth1, 2), placement(at(-1, -7.5, 0), truth1, true),
+              /*tentative=*/true);
+    ASSERT_FALSE(graph.anchored(1));
+    Placement second = placement(at(-1.5, -13.5, 1), at(-1.5, -13.5, 1), false);
+    second.track = "robot2";
+    graph.add(quick_yard_scan(truth2, 3), second);
+    ASSERT_FALSE(graph.anchored(1));
+    ASSERT_FALSE(graph.anchored(2));
+    const Pose matched2 = at(truth2.x + map_off_m, truth2.y, 0);
+    graph.add_match_to_map(2, matched2, Eigen::Matrix4d::Identity() * 0.3, "rematch");
+    graph.solve();
+    ASSERT_TRUE(graph.anchored(2));
+    EXPECT_EQ(graph.anchored(1), map_off_m == 0.0) << map_off_m << " m";
+    if (map_off_m == 0.0) {
+      EXPECT_NEAR(graph.poses()[1].x, truth1.x, 0.05);
+      EXPECT_NEAR(graph.poses()[1].y, truth1.y, 0.05);
+      bool confirmed = false;
+      for (std::size_t e = 0; e < graph.graph().edges().size(); ++e) {
+        confirmed = confirmed || graph.edge_origin(e) == "map-confirmed";
+      }
+      EXPECT_TRUE(confirmed);
+    }
+  }
 }
 
 // A waiting match said where the scan lies relative to the map as it was when the match ran; if

@@ -76,15 +76,17 @@ class MissionPipeline {
   std::optional<MapMatch> place(const PointCloud& scan, const Pose& reported,
                                 const std::string& track = {}, double driven_m = 0) const;
   // place() in two steps, for an owner that matches without holding its lock: what the match
-  // needs from the map (nothing when there is nothing to match against), then match_to_map.
+  // of `scan` needs from the map (nothing when there is nothing to match against), then
+  // match_to_map.
   struct MatchInput {
     PointCloud map_points;
+    // Its lengths already sized by the scan (RegistrationConfig::adapt_to_scene done).
     MapMatchConfig config;
     Pose prior;        // the reported pose in the map frame: where the match starts
     MatchViews views;  // where map_points were seen from, and the new scan's scanner
   };
-  std::optional<MatchInput> match_input(const Pose& reported, const std::string& track = {},
-                                        double driven_m = 0) const;
+  std::optional<MatchInput> match_input(const PointCloud& scan, const Pose& reported,
+                                        const std::string& track = {}, double driven_m = 0) const;
   // `reported` carried into the map frame by what the anchored scans say of the pose sensors'
   // frame (SensorFrame): where an unmatched scan is best placed.
   // With drifting odometry and the graph on, the robot's latest scan as the graph has it,
@@ -215,7 +217,7 @@ class MissionPipeline {
   bool reaches(std::size_t i, double x, double y, double radius_m) const;
   std::vector<std::size_t> match_sources(double x, double y, double radius_m) const;
   PointCloud points_of(const std::vector<std::size_t>& scans, double x, double y, double radius_m,
-                       Viewpoints* views) const;
+                       Viewpoints* views, double thinned_to_m = 0) const;
   void set_cloud(std::size_t i, std::shared_ptr<const PointCloud> in_map);
   MapCorrection correction(const GraphUpdate& update, const std::vector<Pose>& before) const;
   void replace();

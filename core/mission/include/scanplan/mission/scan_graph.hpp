@@ -118,8 +118,9 @@ class ScanGraph {
   // A map match of a scan whose estimate may be off by more than the sensors' usual reach (a
   // far correction, or a prior after long drives with nothing anchored): it waits until the
   // robot's scan before or after, matched the same way, or the one after placed by its own
-  // match, lies where the odometry between the two says (confirm_by_odometry). Call solve()
-  // after.
+  // match, lies where the odometry between the two says (confirm_by_odometry), or until a
+  // pairwise match with a later scan in the map puts it where the map match did
+  // (later_pair_confirms). Call solve() after.
   void offer_match_to_map(std::size_t scan, const Pose& placed, const Eigen::Matrix4d& information);
   // The pose sensors alone place scan `scan` closely enough (MissionPipeline::sensors_place):
   // it is tied to scan `from` (the first scan for an absolute fix, the robot's last anchored
@@ -155,6 +156,8 @@ class ScanGraph {
   const Pose& reported(std::size_t scan) const { return reported_.at(scan); }
   // The scan levelled at its pose (levelled()), thinned as matching thins it.
   const PointCloud& thinned(std::size_t scan) const { return *thinned_.at(scan); }
+  // The voxel it was thinned to (RegistrationConfig::voxel_m sized by the scan's own range).
+  double thinned_voxel_m(std::size_t scan) const { return thinned_voxel_.at(scan); }
   // How far off the scan's estimate may be while no believed match ties it in (zero once one
   // does).
   const MoveUncertainty& uncertainty(std::size_t scan) const { return uncertain_.at(scan); }
@@ -162,7 +165,8 @@ class ScanGraph {
   // How each edge of graph() came about, by index: "odometry", "fix" (an absolute fix),
   // "pair-search" (a pairwise match, the search first: one end was not anchored), "map" (a
   // scan-to-map match when the scan came), "map-confirmed" (one beyond the sensors' reach,
-  // confirmed by the odometry to the robot's next or previous scan), "rematch" (one later),
+  // confirmed by the odometry to the robot's next or previous scan or by a pairwise match with a
+  // later scan in the map), "rematch" (one later),
   // "sensors" (anchor_by_sensors).
   const std::string& edge_origin(std::size_t edge) const { return origins_.at(edge); }
   const ScanGraphConfig& config() const { return config_; }
@@ -190,6 +194,9 @@ class ScanGraph {
   bool odometry_agrees(std::size_t a, const Pose& a_placed, std::size_t b,
                        const Pose& b_placed) const;
   void confirm_by_odometry(std::size_t scan);
+  bool agree(const Pose& a, const Pose& b) const;
+  bool later_pair_confirms(std::size_t scan, const GraphEdge& edge) const;
+  bool confirm_waiting(const GraphSolveReport& solve);
   void believe_waiting(std::size_t scan);
   // A map match: where it placed the scan, and the anchored scan nearest to that (`reference`)
   // where the map had it when the match ran.
@@ -209,6 +216,7 @@ class ScanGraph {
   PoseNoise noise_;
   PoseGraph graph_;
   std::vector<std::shared_ptr<const PointCloud>> thinned_;  // levelled, per scan
+  std::vector<double> thinned_voxel_;                       // per scan
   std::vector<Viewpoints> scanners_;                        // per scan, as add() was told
   std::vector<Pose> reported_;
   std::vector<double> driven_;  // per scan: Placement::driven_m, the drive that led to it
