@@ -98,13 +98,7 @@ export class CandidatesPanel {
     }
     // "On its way" holds while the move does: a refusal or an arrival says otherwise.
     const now = this.list.find((c) => c.id === this.selected);
-    if (this.messageState && now && now.state !== this.messageState) {
-      this.messageState = null;
-      this.message = now.state === 'refused'
-        ? `refused by ${now.robot || this.plan?.robot || 'the robot'}${now.note ? `: ${now.note}` : ''}`
-        : '';
-      this.messageIsError = now.state === 'refused';
-    }
+    if (this.messageState && now && now.state !== this.messageState) this._stateChanged(now);
     if (this.selected == null) {
       // Keep the eye on what matters: a move under way, else the best proposal.
       const moving = this.list.find((c) => c.state === 'moving' || c.state === 'interrupted');
@@ -138,6 +132,15 @@ export class CandidatesPanel {
 
   get several() {
     return this.plans.length > 1;
+  }
+
+  /** The selected candidate left the state the message was about: say what it is now. */
+  _stateChanged(now) {
+    this.messageState = null;
+    this.message = now.state === 'refused'
+      ? `refused by ${now.robot || this.plan?.robot || 'the robot'}${now.note ? `: ${now.note}` : ''}`
+      : '';
+    this.messageIsError = now.state === 'refused';
   }
 
   _say(text, isError = false) {
@@ -251,13 +254,22 @@ export class CandidatesPanel {
 
   async _decide(c, action, body) {
     this.busy = true;
+    // A robot may refuse (or the move end) before the approval's reply is back: the new state
+    // then reaches setData first, and says so in place of "sending…".
+    const sentFrom = action === 'approve' ? c.state : null;
+    this.messageState = sentFrom;
     this._say(`${action}: sending…`);
     try {
       await sendJson(`/api/v1/candidates/${c.id}/${action}`, body);
       this.busy = false;
       const done = { approve: 'approved: the robot is on its way', reject: 'rejected', cancel: 'move stopped' }[action];
-      this.messageState = action === 'approve' ? 'moving' : null;
-      this._say(done);
+      const now = this.current;
+      if (sentFrom && now?.id === c.id && now.state !== sentFrom && now.state !== 'moving') {
+        this.render(); // already answered: the refusal or the end of the move stays in view
+      } else {
+        this.messageState = action === 'approve' ? 'moving' : null;
+        this._say(done);
+      }
       this.onChanged();
     } catch (e) {
       this.busy = false;
