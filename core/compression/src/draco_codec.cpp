@@ -4,22 +4,46 @@
 #include <draco/compression/encode.h>
 #include <draco/point_cloud/point_cloud_builder.h>
 
+#include <cstdint>
+#include <limits>
+
 namespace scanplan {
 
 std::string encode_draco(const PointCloud& cloud, const DracoOptions& options) {
-  if (cloud.empty()) throw DracoError("cannot encode an empty point cloud");
-  const auto n = static_cast<draco::PointIndex::ValueType>(cloud.size());
-  draco::PointCloudBuilder builder;
-  builder.Start(n);
-  const int pos = builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
-  builder.SetAttributeValuesForAllPoints(pos, cloud.points.data(), sizeof(Eigen::Vector3f));
-  int col = -1;
-  if (cloud.has_colors()) {
-    col = builder.AddAttribute(draco::GeometryAttribute::COLOR, 3, draco::DT_UINT8);
-    builder.SetAttributeValuesForAllPoints(col, cloud.colors.data(), sizeof(Rgb));
+  return encode_draco(std::vector<const PointCloud*>{&cloud}, options);
+}
+
+std::string encode_draco(const std::vector<const PointCloud*>& parts, const DracoOptions& options) {
+  std::size_t total = 0;
+  bool colored = true;
+  for (const PointCloud* part : parts) {
+    total += part->size();
+    colored = colored && (part->empty() || part->has_colors());  // as PointCloud::append
   }
+  if (total == 0) throw DracoError("cannot encode an empty point cloud");
+  if (total > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max())) {
+    throw DracoError("too many points for one Draco point cloud: " + std::to_string(total));
+  }
+  draco::PointCloudBuilder builder;
+  builder.Start(static_cast<draco::PointIndex::ValueType>(total));
+  const int pos = builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
+  const int col =
+      colored ? builder.AddAttribute(draco::GeometryAttribute::COLOR, 3, draco::DT_UINT8) : -1;
   std::unique_ptr<draco::PointCloud> pc = builder.Finalize(false);
   if (!pc) throw DracoError("draco could not build the point cloud");
+  // Each part's values in one copy per attribute (both are packed: 12 and 3 bytes a point).
+  static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float) && sizeof(Rgb) == 3);
+  std::int64_t at = 0;
+  for (const PointCloud* part : parts) {
+    pc->attribute(pos)->buffer()->Write(at * static_cast<std::int64_t>(sizeof(Eigen::Vector3f)),
+                                        part->points.data(),
+                                        part->size() * sizeof(Eigen::Vector3f));
+    if (col >= 0) {
+      pc->attribute(col)->buffer()->Write(at * static_cast<std::int64_t>(sizeof(Rgb)),
+                                          part->colors.data(), part->size() * sizeof(Rgb));
+    }
+    at += static_cast<std::int64_t>(part->size());
+  }
   if (col >= 0) pc->attribute(col)->set_normalized(true);
 
   draco::Encoder encoder;

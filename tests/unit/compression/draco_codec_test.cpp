@@ -106,5 +106,24 @@ TEST(DracoCodec, CloudWithoutColoursDecodesWithoutColours) {
   EXPECT_FALSE(out.has_colors());
 }
 
+// The whole map is encoded from the scans' clouds as they are (no copy of the map first): the
+// same bytes as the clouds appended into one.
+TEST(DracoCodec, PartsEncodeAsTheirConcatenation) {
+  const PointCloud a = random_cloud(3000, 80, 2), b = random_cloud(5000, 120, 3);
+  const PointCloud empty;
+  PointCloud both = a;
+  both.append(b);
+  EXPECT_TRUE(encode_draco(std::vector<const PointCloud*>{&a, &empty, &b}) == encode_draco(both))
+      << "the same bytes as the parts appended into one";
+
+  // One part without colours: none are encoded.
+  PointCloud grey = random_cloud(100, 5, 4);
+  grey.colors.clear();
+  const PointCloud out = decode_draco(encode_draco(std::vector<const PointCloud*>{&a, &grey}));
+  EXPECT_EQ(out.size(), a.size() + grey.size());
+  EXPECT_FALSE(out.has_colors());
+  EXPECT_THROW(encode_draco(std::vector<const PointCloud*>{&empty}), DracoError);
+}
+
 }  // namespace
 }  // namespace scanplan

@@ -3,6 +3,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "scanplan/geometry/point_cloud.hpp"
 
@@ -27,6 +28,11 @@ class DracoError : public std::runtime_error {
 // Positions as float32 and, when the cloud has them, colours as normalised uint8 so that
 // three.js's DRACOLoader hands the page 0..1 colours without conversion.
 std::string encode_draco(const PointCloud& cloud, const DracoOptions& options = {});
+// The clouds one after the other as one Draco point cloud, without first copying them into one
+// (the whole map of a session: hundreds of megabytes); colours only when every part that has
+// points has them.
+std::string encode_draco(const std::vector<const PointCloud*>& parts,
+                         const DracoOptions& options = {});
 PointCloud decode_draco(std::string_view bytes);
 
 }  // namespace scanplan
