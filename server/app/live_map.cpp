@@ -89,8 +89,8 @@ void LiveMap::encode_loop() {
       if (count > 0) encoded = std::make_shared<const std::string>(encode_draco(clouds));
       parts.clear();
       // Draco's working memory is hundreds of megabytes at millions of points, freed by now
-      // but kept by the allocator: handed back, a laptop's other programs (and the next
-      // scan's match) get it.
+      // but kept by the allocator: handed back, the laptop's other programs get it (the next
+      // scan's match faults its pages in again; within the benchmarks' spread).
       malloc_trim(0);
     } catch (const std::exception&) {
       // Out of memory or a Draco failure: the previous encoding stays; readers see its
