@@ -24,6 +24,13 @@ Eigen::Matrix4d match_information(const Eigen::Matrix4d& per_point, double sigma
   return per_point / (sigma_m * sigma_m) + diagonal_information(10.0, 10.0, deg2rad(10.0));
 }
 
+// Per edge of a graph of `edges` edges: whether the solve set it aside as an outlier.
+std::vector<std::uint8_t> outlier_flags(std::size_t edges, const GraphSolveReport& solve) {
+  std::vector<std::uint8_t> outlier(edges, 0);
+  for (const std::size_t e : solve.outliers) outlier[e] = 1;
+  return outlier;
+}
+
 }  // namespace
 
 Pose level(Pose pose) {
@@ -263,8 +270,7 @@ bool ScanGraph::confirm_waiting(const GraphSolveReport& solve) {
     confirm_by_odometry(n);
     any = any || !pending_map_[p];
   }
-  std::vector<std::uint8_t> outlier(graph_.edges().size(), 0);
-  for (const std::size_t e : solve.outliers) outlier[e] = 1;
+  const std::vector<std::uint8_t> outlier = outlier_flags(graph_.edges().size(), solve);
   for (std::size_t e = 0; e < outlier.size(); ++e) {  // believing adds edges, none a pair
     if (outlier[e] || anchors_[e] != kNoNode || origins_[e] != "pair-search") continue;
     const GraphEdge edge = graph_.edges()[e];  // a copy: believing adds edges
@@ -438,8 +444,7 @@ std::optional<GraphEdge> ScanGraph::match_pair(std::size_t from, std::size_t to,
 }
 
 void ScanGraph::update_anchors(const GraphSolveReport& solve) {
-  std::vector<std::uint8_t> outlier(graph_.edges().size(), 0);
-  for (const std::size_t e : solve.outliers) outlier[e] = 1;
+  const std::vector<std::uint8_t> outlier = outlier_flags(graph_.edges().size(), solve);
   std::fill(anchored_.begin(), anchored_.end(), 0);
   anchored_[0] = 1;
   for (std::size_t e = 0; e < graph_.edges().size(); ++e) {
