@@ -219,6 +219,7 @@ RegistrationResult GicpMatcher::align(const Eigen::Isometry3d& initial, Dof dof)
       // runs out of iterations has still brought the source close enough for the next.
       if (k + 1 == stages_.size()) {
         r.converged = settled;
+        r.ran_out = !settled;
         if (!settled) {
           r.message = "GICP did not settle within " +
                       std::to_string(config_.max_iterations_per_stage) + " iterations";

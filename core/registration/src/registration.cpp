@@ -344,12 +344,18 @@ RegistrationResult register_with(const PointCloud& target, const PointCloud& sou
 
   const AlignmentQuality q =
       evaluate_alignment(t, s, r.transform, c.dof, c.score_max_distance_m, c.inlier_distance_m,
-                         /*with_constraint=*/r.converged);
+                         /*with_constraint=*/r.converged || r.ran_out);
   r.score = q.score;
   r.rmse = q.rmse;
   r.inlier_ratio = q.inlier_ratio;
-  r.weakest_constraint = q.weakest_constraint;
-  r.information = q.information;
+  if (r.converged) {
+    r.weakest_constraint = q.weakest_constraint;
+    r.information = q.information;
+  }
+  if (r.ran_out && !r.converged && q.inlier_ratio >= c.min_inlier_ratio) {
+    // Where the solver stopped, the scans overlap: a weak constraint there is the reason.
+    if (std::optional<std::string> why = rejection(q, c)) r.message = *why + "; " + r.message;
+  }
   if (r.converged) {
     if (std::optional<std::string> why = rejection(q, c, r.held_on_restart)) {
       r.converged = false;

@@ -233,8 +233,8 @@ INSTANTIATE_TEST_SUITE_P(AllMethods, FailingInput, ::testing::ValuesIn(kAllMetho
                            return name;
                          });
 
-TEST(Registration, CorridorIsNotReportedAsConverged) {
-  // Two long parallel walls and a floor: nothing fixes the position along the corridor.
+// Two long parallel walls and a floor: nothing fixes the position along the corridor.
+PointCloud corridor_cloud() {
   PointCloud corridor;
   std::mt19937_64 rng(9);
   std::uniform_real_distribution<double> along(-40, 40), up(0, 3), across(-2, 2);
@@ -252,6 +252,11 @@ TEST(Registration, CorridorIsNotReportedAsConverged) {
         break;
     }
   }
+  return corridor;
+}
+
+TEST(Registration, CorridorIsNotReportedAsConverged) {
+  const PointCloud corridor = corridor_cloud();
   Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
   start.translation().x() = 1.5;
   // search-gicp's restart check does not rescue it: restarted a metre along the corridor, GICP
@@ -262,6 +267,22 @@ TEST(Registration, CorridorIsNotReportedAsConverged) {
     EXPECT_FALSE(r.held_on_restart) << method_name(m);
     EXPECT_NE(r.message.find("corridor"), std::string::npos) << r.message;
   }
+}
+
+// A match that runs out of iterations where the scans overlap says what held it there: in a
+// corridor GICP slides along it a few millimetres a step, and "did not settle" alone does not
+// tell the operator why.
+TEST(Registration, AMatchThatRunsOutInACorridorSaysSo) {
+  const PointCloud corridor = corridor_cloud();
+  RegistrationConfig c = fast_config(Dof::k4);
+  c.gicp.max_iterations_per_stage = 1;
+  const RegistrationResult r =
+      register_scans(corridor, corridor, pose(1.5, 0.3, 0.0, 2).isometry(), Method::kGicp, c);
+  EXPECT_FALSE(r.converged);
+  EXPECT_TRUE(r.ran_out);
+  EXPECT_NE(r.message.find("corridor"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("did not settle"), std::string::npos) << r.message;
+  EXPECT_EQ(r.weakest_constraint, 0.0);  // not settled: no constraint is reported as measured
 }
 
 // A result whose weakest constraint falls short of the check (here an unreachable one) is

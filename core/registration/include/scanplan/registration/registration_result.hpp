@@ -36,6 +36,10 @@ struct RegistrationResult {
   double time_ms = 0;  // the alignment itself: downsampling and scoring excluded
   bool converged =
       false;  // the solver stopped on its tolerances AND the result passed the sanity check
+  // The solver used up its iterations without settling: `transform` is where it stopped. Along
+  // a corridor it slides a few millimetres a step for ever, so the check is still made there
+  // for the message (a corridor says why better than "did not settle").
+  bool ran_out = false;
   std::string method;   // "ndt-icp", "ndt", "icp", "pcl-ndt", "pcl-icp", "pcl-gicp"
   std::string message;  // why it did not converge, or a note (e.g. "PCL solves 6 DOF")
 };
