@@ -320,8 +320,8 @@ RegistrationResult align(const PointCloud& target, const PointCloud& source,
     }
     // Only the finest cell size decides: the coarse ones are there to bring it into range.
     result.converged = outcome.converged;
-    result.ran_out = !outcome.converged;
     if (!outcome.converged && level + 1 == config.cell_sizes_m.size()) {
+      result.ran_out = true;
       result.message = "NDT did not settle within " + std::to_string(config.max_iterations) +
                        " iterations at cell size " + metres(cell);
     }
