@@ -351,12 +351,6 @@ RegistrationResult register_with(const PointCloud& target, const PointCloud& sou
   if (r.converged) {
     r.weakest_constraint = q.weakest_constraint;
     r.information = q.information;
-  }
-  if (r.ran_out && !r.converged && q.inlier_ratio >= c.min_inlier_ratio) {
-    // Where the solver stopped, the scans overlap: a weak constraint there is the reason.
-    if (std::optional<std::string> why = rejection(q, c)) r.message = *why + "; " + r.message;
-  }
-  if (r.converged) {
     if (std::optional<std::string> why = rejection(q, c, r.held_on_restart)) {
       r.converged = false;
       r.message = std::move(*why);
@@ -366,6 +360,9 @@ RegistrationResult register_with(const PointCloud& target, const PointCloud& sou
       r.message = std::string("the surfaces fix the pose only weakly (weakest constraint ") + buf +
                   "), but GICP restarted around the result came back to it each time";
     }
+  } else if (r.ran_out && q.inlier_ratio >= c.min_inlier_ratio) {
+    // Where the solver stopped, the scans overlap: a weak constraint there is the reason.
+    if (std::optional<std::string> why = rejection(q, c)) r.message = *why + "; " + r.message;
   }
   return r;
 }
