@@ -5,8 +5,43 @@ namespace scanplan {
 MappingPipeline::MappingPipeline(PipelineConfig config) : config_(config), map_(config.mls) {}
 
 InsertStats MappingPipeline::add_scan(const PointCloud& cloud, const Pose& pose) {
-  const InsertStats stats =
-      map_.insert_scan(cloud, pose.isometry(), Eigen::Vector3d(0, 0, config_.sensor_height_m));
+  const InsertStats stats = map_.insert_scan(cloud, pose.isometry(), sensor());
+  joined(pose);
+  return stats;
+}
+
+InsertStats MappingPipeline::add_placed_scan(const PointCloud& in_map, const Pose& pose) {
+  const InsertStats stats = map_.insert_placed_scan(in_map, pose.isometry(), sensor());
+  joined(pose);
+  return stats;
+}
+
+void MappingPipeline::replace_scans(const std::vector<PlacedScan>& scans,
+                                    const std::vector<Bounds3>& changed) {
+  MlsMap::Tiles tiles = map_.tiles();
+  for (const Bounds3& box : changed) tiles.add(box);
+  poses_.clear();
+  for (const PlacedScan& s : scans) poses_.push_back(s.pose);
+  if (!tiles.empty()) {
+    map_.clear(tiles);
+    for (const PlacedScan& s : scans) {
+      if (tiles.reaches(s.bounds)) {
+        map_.insert_placed_scan(*s.in_map, s.pose.isometry(), sensor(), &tiles);
+      }
+    }
+  }
+  if (poses_.empty()) {
+    regions_.reset();
+    movable_.reset();
+  }
+  update_regions();
+}
+
+Eigen::Vector3d MappingPipeline::sensor() const {
+  return {0, 0, config_.sensor_height_m};
+}
+
+void MappingPipeline::joined(const Pose& pose) {
   poses_.push_back(pose);
   if (!target_) {
     const Eigen::Vector2d half = Eigen::Vector2d::Constant(config_.default_target_side_m / 2);
@@ -14,7 +49,6 @@ InsertStats MappingPipeline::add_scan(const PointCloud& cloud, const Pose& pose)
     target_ = TargetRegion::rectangle(c - half, c + half);
   }
   update_regions();
-  return stats;
 }
 
 void MappingPipeline::set_target(TargetRegion target) {

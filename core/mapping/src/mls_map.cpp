@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 namespace scanplan {
@@ -73,14 +74,44 @@ std::optional<std::pair<CellIndex, CellIndex>> MlsMap::extent() const {
   return std::make_pair(min_, max_);
 }
 
+// The cursor moves to another tile: looked up, made if need be, unless outside its `only`.
+void MlsMap::enter_tile(std::int32_t tx, std::int32_t ty, Cursor& at) {
+  at.valid = true;
+  at.key = tile_key(tx, ty);
+  at.tile = nullptr;
+  if (at.only && !at.only->contains(tx, ty)) return;
+  auto& slot = tiles_[at.key];
+  if (!slot) slot = std::make_unique<Tile>();
+  at.tile = slot.get();
+}
+
+// Inlined, as insert_point: the per-point path of every insertion.
+[[gnu::always_inline]] inline MlsCell* MlsMap::cell_at(CellIndex c, Cursor& at) {
+  const std::int32_t tx = c.x >> kTileBits, ty = c.y >> kTileBits;
+  if (!at.valid || tile_key(tx, ty) != at.key) enter_tile(tx, ty, at);
+  if (!at.tile) return nullptr;
+  return &at.tile->cells[(c.y & (kTileSize - 1)) * kTileSize + (c.x & (kTileSize - 1))];
+}
+
+[[gnu::always_inline]] inline void MlsMap::insert_point(const Eigen::Vector3f& p, Cursor& at) {
+  const CellIndex index = index_of(p.x(), p.y());
+  MlsCell* c = cell_at(index, at);
+  if (!c) return;
+  if (c->empty()) occupy(index);
+  if (c->interpolated) {
+    c->size = 0;
+    c->interpolated = false;
+  }
+  add_to_cell(*c, p.z());
+}
+
 InsertStats MlsMap::insert(const PointCloud& cloud) {
   return insert(cloud.points);
 }
 
 InsertStats MlsMap::insert(const std::vector<Eigen::Vector3f>& points) {
   InsertStats stats;
-  Tile* cached = nullptr;
-  std::uint64_t cached_key = 0;
+  Cursor at;
   const float limit = static_cast<float>(config_.max_coordinate_m);
   for (const Eigen::Vector3f& p : points) {
     // NaN fails every comparison, so this refuses NaN, ±inf and the absurdly far alike.
@@ -88,97 +119,186 @@ InsertStats MlsMap::insert(const std::vector<Eigen::Vector3f>& points) {
       ++stats.rejected;
       continue;
     }
-    insert_point(p, cached, cached_key);
+    insert_point(p, at);
     ++stats.inserted;
   }
   return stats;
 }
 
-void MlsMap::insert_point(const Eigen::Vector3f& p, Tile*& cached, std::uint64_t& cached_key) {
-  MlsCell& c = touch(index_of(p.x(), p.y()), cached, cached_key);
-  if (c.interpolated) {
-    c.size = 0;
-    c.interpolated = false;
+void MlsMap::occupy(CellIndex c) {
+  if (occupied_ == 0) {
+    min_ = max_ = c;
+  } else {
+    min_ = {std::min(min_.x, c.x), std::min(min_.y, c.y)};
+    max_ = {std::max(max_.x, c.x), std::max(max_.y, c.y)};
   }
-  add_to_cell(c, p.z());
-}
-
-MlsCell& MlsMap::touch(CellIndex c, Tile*& cached, std::uint64_t& cached_key) {
-  const std::uint64_t key = tile_key(c.x >> kTileBits, c.y >> kTileBits);
-  if (!cached || key != cached_key) {
-    auto& slot = tiles_[key];
-    if (!slot) slot = std::make_unique<Tile>();
-    cached = slot.get();
-    cached_key = key;
-  }
-  MlsCell& cell = cached->cells[(c.y & (kTileSize - 1)) * kTileSize + (c.x & (kTileSize - 1))];
-  if (cell.empty()) {
-    if (occupied_ == 0) {
-      min_ = max_ = c;
-    } else {
-      min_ = {std::min(min_.x, c.x), std::min(min_.y, c.y)};
-      max_ = {std::max(max_.x, c.x), std::max(max_.y, c.y)};
-    }
-    ++occupied_;
-  }
-  return cell;
+  ++occupied_;
 }
 
 InsertStats MlsMap::insert_scan(const PointCloud& scan, const Eigen::Isometry3d& map_from_scan,
-                                const Eigen::Vector3d& sensor_in_scan) {
+                                const Eigen::Vector3d& sensor_in_scan, const Tiles* only) {
+  return insert_fans<false>(scan, map_from_scan, sensor_in_scan, only);
+}
+
+InsertStats MlsMap::insert_placed_scan(const PointCloud& in_map,
+                                       const Eigen::Isometry3d& map_from_scan,
+                                       const Eigen::Vector3d& sensor_in_scan, const Tiles* only) {
+  return insert_fans<true>(in_map, map_from_scan, sensor_in_scan, only);
+}
+
+// kPlaced: the points are in the map frame already; which beams share a fan is still judged in
+// the scan's own frame, where a fan is a vertical half-plane.
+template <bool kPlaced>
+InsertStats MlsMap::insert_fans(const PointCloud& scan, const Eigen::Isometry3d& map_from_scan,
+                                const Eigen::Vector3d& sensor_in_scan, const Tiles* only) {
   InsertStats stats;
-  Tile* cached = nullptr;
-  std::uint64_t cached_key = 0;
+  Cursor at;
+  at.only = only;
   const Eigen::Isometry3f T = map_from_scan.cast<float>();
+  const Eigen::Isometry3f T_inverse = map_from_scan.inverse().cast<float>();
   const Eigen::Vector3f sensor = sensor_in_scan.cast<float>();
   const float limit = static_cast<float>(config_.max_coordinate_m);
-  bool have_prev = false;
-  Eigen::Vector3f prev_map = Eigen::Vector3f::Zero(), prev_dir = Eigen::Vector3f::Zero();
-  for (const Eigen::Vector3f& p : scan.points) {
-    const Eigen::Vector3f q = T * p;
+  // Neighbouring beams of one fan share their azimuth; both must look down at the ground, by
+  // more than a level beam carried into the map frame and back can (its last bit must not
+  // decide).
+  struct Beam {
+    Eigen::Vector3f d;
+    float horizontal;
+    bool usable;
+  };
+  const auto beam_of = [&](const Eigen::Vector3f& point) {
+    const Eigen::Vector3f p = kPlaced ? Eigen::Vector3f(T_inverse * point) : point;
+    Beam b{p - sensor, 0, false};
+    b.horizontal = std::sqrt(b.d.x() * b.d.x() + b.d.y() * b.d.y());  // never near overflow
+    b.usable = b.d.z() < -1e-3f * b.horizontal && b.horizontal > 0.3f;
+    return b;
+  };
+  // The previous point, when it was not refused; its beam only once needed (see below).
+  const Eigen::Vector3f* prev = nullptr;
+  std::optional<Beam> prev_beam;
+  Eigen::Vector3f prev_map = Eigen::Vector3f::Zero();
+  std::uint64_t prev_key = 0;
+  bool prev_outside = false;
+  for (const Eigen::Vector3f& point : scan.points) {
+    const Eigen::Vector3f q = kPlaced ? point : Eigen::Vector3f(T * point);
     if (!(std::abs(q.x()) < limit && std::abs(q.y()) < limit && std::abs(q.z()) < limit)) {
       ++stats.rejected;
-      have_prev = false;
+      prev = nullptr;
       continue;
     }
-    insert_point(q, cached, cached_key);
+    insert_point(q, at);  // leaves the cursor on q's tile
     ++stats.inserted;
     if (!config_.fill_between_beams) continue;
-    // Neighbouring beams of one fan share their azimuth; both must look down at the ground.
-    const Eigen::Vector3f d = p - sensor;
-    const float horizontal = std::hypot(d.x(), d.y());
-    const bool usable = d.z() < 0 && horizontal > 0.3f;
-    if (usable && have_prev) {
-      const float cos_az = (d.x() * prev_dir.x() + d.y() * prev_dir.y()) /
-                           (horizontal * std::hypot(prev_dir.x(), prev_dir.y()));
-      // Same fan: azimuths within about a quarter degree.
-      if (cos_az > 0.99999f) fill_between(prev_map, q, cached, cached_key);
+    const bool outside = at.tile == nullptr;
+    const std::uint64_t key = at.key;
+    // Two points in one tile outside `only` fill nothing (fill_between stays within the pair's
+    // box): restricted, most of a scan passes without its beams worked out.
+    if (prev && outside && prev_outside && key == prev_key) {
+      prev_beam.reset();
+    } else {
+      const Beam beam = beam_of(point);
+      if (prev && beam.usable) {
+        if (!prev_beam) prev_beam = beam_of(*prev);
+        const Beam& b = *prev_beam;
+        const float cos_az =
+            (beam.d.x() * b.d.x() + beam.d.y() * b.d.y()) / (beam.horizontal * b.horizontal);
+        // Same fan: azimuths within about a quarter degree.
+        if (b.usable && cos_az > 0.99999f) fill_between(prev_map, q, at);
+      }
+      prev_beam = beam;
     }
-    have_prev = usable;
+    prev = &point;
     prev_map = q;
-    prev_dir = d;
+    prev_key = key;
+    prev_outside = outside;
   }
   return stats;
 }
 
-void MlsMap::fill_between(const Eigen::Vector3f& a, const Eigen::Vector3f& b, Tile*& cached,
-                          std::uint64_t& cached_key) {
+void MlsMap::fill_between(const Eigen::Vector3f& a, const Eigen::Vector3f& b, Cursor& at) {
   const Eigen::Vector2f delta = b.head<2>() - a.head<2>();
   const float length = delta.norm();
   if (length < config_.cell_m || length > config_.fill_max_gap_m) return;
   if (std::abs(b.z() - a.z()) > config_.fill_max_slope * length) return;
+  if (at.only) {
+    Bounds3 segment;
+    segment.extend(a);
+    segment.extend(b);
+    if (!at.only->reaches(segment)) return;  // nothing it crosses may be written
+  }
   // Half-cell steps visit every cell the segment crosses.
   const int steps = static_cast<int>(std::ceil(length / (0.5 * config_.cell_m)));
   for (int k = 1; k < steps; ++k) {
-    const Eigen::Vector3f p = a + (b - a) * (static_cast<float>(k) / static_cast<float>(steps));
+    Eigen::Vector3f p = a + (b - a) * (static_cast<float>(k) / static_cast<float>(steps));
+    // Within the pair's box to the last bit, so that a pair in one tile fills only that tile.
+    p.head<2>() = p.head<2>().cwiseMax(a.head<2>().cwiseMin(b.head<2>()));
+    p.head<2>() = p.head<2>().cwiseMin(a.head<2>().cwiseMax(b.head<2>()));
     const CellIndex c = index_of(p.x(), p.y());
     // Only cells the laser saw nothing in: measured surfaces keep their own statistics.
-    const MlsCell* existing = cell(c);
-    if (existing) continue;
-    MlsCell& filled = touch(c, cached, cached_key);
-    add_to_cell(filled, p.z());
-    filled.interpolated = true;
+    MlsCell* filled = cell_at(c, at);
+    if (!filled || !filled->empty()) continue;
+    occupy(c);
+    add_to_cell(*filled, p.z());
+    filled->interpolated = true;
   }
+}
+
+std::optional<MlsMap::Tiles::Rect> MlsMap::Tiles::rect_of(const Bounds3& box) const {
+  if (!box.valid()) return std::nullopt;
+  // Beyond max_coordinate_m nothing is stored; one cell of margin for rounding.
+  const auto tile = [&](float v, double margin) {
+    const double clamped =
+        std::clamp(static_cast<double>(v) + margin, -max_coordinate_m_, max_coordinate_m_);
+    return static_cast<std::int32_t>(std::floor(clamped * inv_cell_)) >> kTileBits;
+  };
+  const double cell = 1.0 / inv_cell_;
+  return Rect{tile(box.min.x(), -cell), tile(box.min.y(), -cell), tile(box.max.x(), cell),
+              tile(box.max.y(), cell)};
+}
+
+void MlsMap::Tiles::add(const Bounds3& box) {
+  if (const auto r = rect_of(box)) rects_.push_back(*r);
+}
+
+bool MlsMap::Tiles::contains(std::int32_t tx, std::int32_t ty) const {
+  return std::any_of(rects_.begin(), rects_.end(), [&](const Rect& r) {
+    return tx >= r.x0 && tx <= r.x1 && ty >= r.y0 && ty <= r.y1;
+  });
+}
+
+bool MlsMap::Tiles::reaches(const Bounds3& box) const {
+  const auto b = rect_of(box);
+  if (!b) return false;
+  return std::any_of(rects_.begin(), rects_.end(), [&](const Rect& r) {
+    return b->x0 <= r.x1 && r.x0 <= b->x1 && b->y0 <= r.y1 && r.y0 <= b->y1;
+  });
+}
+
+void MlsMap::clear(const Tiles& tiles) {
+  for (auto it = tiles_.begin(); it != tiles_.end();) {
+    const std::int32_t tx = static_cast<std::int32_t>(it->first >> 32);
+    const std::int32_t ty = static_cast<std::int32_t>(it->first & 0xffffffffu);
+    if (!tiles.contains(tx, ty)) {
+      ++it;
+      continue;
+    }
+    for (const MlsCell& c : it->second->cells) occupied_ -= c.empty() ? 0 : 1;
+    it = tiles_.erase(it);
+  }
+  recompute_extent();
+}
+
+void MlsMap::recompute_extent() {
+  bool any = false;
+  for_each_cell([&](CellIndex c, const MlsCell&) {
+    if (!any) {
+      min_ = max_ = c;
+      any = true;
+      return;
+    }
+    min_ = {std::min(min_.x, c.x), std::min(min_.y, c.y)};
+    max_ = {std::max(max_.x, c.x), std::max(max_.y, c.y)};
+  });
 }
 
 void MlsMap::add_to_cell(MlsCell& cell, float z) {

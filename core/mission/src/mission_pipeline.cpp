@@ -147,7 +147,7 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
   in_map_.push_back(0);
   goals_.push_back(where.goal);
   if (!graph_) {
-    join_map(scan, placed_.size() - 1);
+    join_map(placed_.size() - 1);
     return;
   }
   const std::vector<Pose> before = poses_;
@@ -170,27 +170,17 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
   last_correction_->graph_ms = ms_between(t0, t1) + ms_between(t2, t3);
 }
 
-void MissionPipeline::join_map(const PointCloud& own, std::size_t i) {
-  mapping_.add_scan(own, poses_[i]);
+// The map holds the scan where its points are (cloud_poses_).
+void MissionPipeline::join_map(std::size_t i) {
+  mapping_.add_placed_scan(*placed_[i], cloud_poses_[i]);
   in_map_[i] = 1;
   if (anchored_[i]) {
     sensor_frame_.add(reported_[i], poses_[i]);
     if (anchored_map_) {
-      anchored_map_->insert_scan(own, poses_[i].isometry(),
-                                 Eigen::Vector3d(0, 0, config_.mapping.sensor_height_m));
+      anchored_map_->insert_placed_scan(*placed_[i], cloud_poses_[i].isometry(),
+                                        Eigen::Vector3d(0, 0, config_.mapping.sensor_height_m));
     }
   }
-}
-
-PointCloud MissionPipeline::own_frame(std::size_t i) const {
-  const Eigen::Isometry3f own_from_map = cloud_poses_[i].isometry().inverse().cast<float>();
-  const PointCloud& in_map = *placed_[i];
-  PointCloud own;
-  own.reserve(in_map.size());
-  for (std::size_t p = 0; p < in_map.size(); ++p) {
-    own.push_back(own_from_map * in_map.points[p], in_map.colors[p]);
-  }
-  return own;
 }
 
 // A scan no match placed joins the map all the same where the pose sensors place it within the
@@ -333,13 +323,14 @@ void MissionPipeline::follow_graph() {
   if (rebuild) {
     poses_ = graph_->poses();
     replace();
-  } else if (anchored_[newest] && !in_map_[newest]) {
-    join_map(own_frame(newest), newest);
+    return;
   }
-  // The points shown follow the graph wherever the scan is, in the map or not.
+  // The points shown follow the graph wherever the scan is, in the map or not; the newest
+  // before it joins, as the map holds a scan where its points are.
   for (std::size_t i = 0; i < placed_.size(); ++i) {
     if (cloud_lags(i)) set_cloud(i, std::make_shared<const PointCloud>(at_estimate(i)));
   }
+  if (anchored_[newest] && !in_map_[newest]) join_map(newest);
 }
 
 // A scan's points are made anew in the map frame only when the graph moved it past replace_m /
@@ -363,22 +354,28 @@ PointCloud MissionPipeline::at_estimate(std::size_t i) const {
   return out;
 }
 
-// The anchored scans back in at their poses: the MLS map cannot take one scan out, and
-// rebuilding it costs a few milliseconds a scan (docs/benchmarks.md mls_campus). Only with the
-// graph, whose map is the anchored one (no anchored_map_ of its own).
+// The map follows the graph: the scans that moved past replace_m / _deg get their points anew
+// and, with those that left the map or joined it late, have the MLS map made anew where they lay
+// and where they lie; the rest of the map stands (MappingPipeline::replace_scans). The map holds
+// each scan where its points are (cloud_poses()). Only with the graph, whose map is the anchored
+// one (no anchored_map_ of its own).
 void MissionPipeline::replace() {
-  const std::optional<TargetRegion> target = mapping_.target();
-  mapping_ = MappingPipeline(with_planner_thresholds(config_.mapping, config_.planner));
-  if (target) mapping_.set_target(*target);
-  sensor_frame_ = SensorFrame(config_.pose_noise);
+  std::vector<Bounds3> changed;
+  std::vector<MappingPipeline::PlacedScan> in_map;
+  std::vector<Pose> reported, placed;
   for (std::size_t i = 0; i < placed_.size(); ++i) {
-    in_map_[i] = 0;
-    const bool moved = cloud_lags(i);
-    if (!moved && !anchored_[i]) continue;  // its points stay as they are, outside the map
-    PointCloud own = own_frame(i);
-    if (moved) set_cloud(i, to_map_frame(own, poses_[i]));
-    if (anchored_[i]) join_map(own, i);
+    const bool lags = cloud_lags(i);
+    if (in_map_[i] && (lags || !anchored_[i])) changed.push_back(cloud_bounds_[i]);
+    if (lags) set_cloud(i, std::make_shared<const PointCloud>(at_estimate(i)));
+    if (anchored_[i] && (lags || !in_map_[i])) changed.push_back(cloud_bounds_[i]);
+    in_map_[i] = anchored_[i];
+    if (!anchored_[i]) continue;
+    in_map.push_back({placed_[i].get(), cloud_poses_[i], cloud_bounds_[i]});
+    reported.push_back(reported_[i]);
+    placed.push_back(poses_[i]);
   }
+  mapping_.replace_scans(in_map, changed);
+  sensor_frame_ = SensorFrame(config_.pose_noise, std::move(reported), std::move(placed));
 }
 
 std::vector<FleetPlan> MissionPipeline::plan(const std::vector<FleetRobot>& robots,

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <utility>
 
 namespace scanplan {
 namespace {
@@ -19,6 +21,14 @@ double wrapped(double a) {
 }
 
 }  // namespace
+
+SensorFrame::SensorFrame(PoseNoise noise, std::vector<Pose> reported, std::vector<Pose> placed)
+    : noise_(noise), reported_(std::move(reported)), placed_(std::move(placed)) {
+  if (reported_.size() != placed_.size()) {
+    throw std::invalid_argument("a sensor frame needs one placed pose for each reported one");
+  }
+  if (!reported_.empty()) refit();
+}
 
 void SensorFrame::add(const Pose& reported, const Pose& placed) {
   reported_.push_back(reported);

@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "mapping_test_support.hpp"
+#include "same_map.hpp"
 #include "scanplan/mapping/mls_map.hpp"
 #include "scanplan/sim/simulated_scanner.hpp"
 
@@ -127,6 +130,92 @@ TEST(MlsMap, AMeasurementReplacesTheHeightsInterpolatedBetweenBeams) {
   map.insert(std::vector<Eigen::Vector3f>{{12.5f, 0.5f, -0.99f}});
   EXPECT_EQ(map.cell({12, 0})->patches[0].count, 3u);
   EXPECT_TRUE(map.cell({11, 0})->interpolated);
+}
+
+// A scan that moved is taken out and put back where it now lies by emptying the tiles it lay and
+// lies in and inserting, restricted to them, every scan that reaches them in the order they came:
+// the map is then what the scans at their new poses make from scratch, cell for cell, and the
+// tiles farther away were not touched.
+TEST(MlsMap, ClearedTilesFilledAgainAreTheMapTheScansMakeFromScratch) {
+  World w = load_world(SCANPLAN_SOURCE_DIR "/samples/worlds/campus.json");
+  w.scanner.rotation_step_deg = 2.0;
+  const RayCaster caster(w);
+  const Eigen::Vector3d sensor(0, 0, w.scanner.mount_height_m);
+  // Four scans across the campus, each kept within 25 m so that the map has tiles one scan alone
+  // reaches; in the map frame, in measuring order.
+  struct Placed {
+    PointCloud in_map;
+    Pose at;
+  };
+  const auto scan_at = [&](double x, double y, double yaw_deg, std::uint64_t seed) {
+    Pose at = w.start;
+    at.x = x, at.y = y, at.z = w.ground_height(x, y), at.yaw = deg2rad(yaw_deg);
+    const PointCloud own = simulate_scan(caster, w.scanner, at, seed);
+    Placed p{{}, at};
+    const Eigen::Isometry3f T = at.isometry().cast<float>();
+    for (const Eigen::Vector3f& q : own.points) {
+      if (std::hypot(q.x(), q.y()) < 25) p.in_map.push_back(T * q, {1, 2, 3});
+    }
+    return p;
+  };
+  std::vector<Placed> scans = {scan_at(40, 60, 0, 1), scan_at(80, 45, 10, 2),
+                               scan_at(150, 90, 0, 3), scan_at(120, 10, 0, 4)};
+  MlsMap map;
+  for (const Placed& s : scans) map.insert_placed_scan(s.in_map, s.at.isometry(), sensor);
+  const CellIndex far = map.index_of(170, 95);
+  const MlsCell* far_before = map.cell(far);
+  ASSERT_NE(far_before, nullptr);
+
+  // The second scan moves 0.36 m and 1°.
+  MlsMap::Tiles changed = map.tiles();
+  changed.add(bounds_of(scans[1].in_map));
+  Placed moved = scans[1];
+  moved.at.x += 0.3, moved.at.y -= 0.2, moved.at.yaw += deg2rad(1.0);
+  const Eigen::Isometry3f shift =
+      (moved.at.isometry() * scans[1].at.isometry().inverse()).cast<float>();
+  for (Eigen::Vector3f& q : moved.in_map.points) q = shift * q;
+  changed.add(bounds_of(moved.in_map));
+  scans[1] = moved;
+  const std::size_t before = map.occupied_cells();
+  map.clear(changed);
+  EXPECT_LT(map.occupied_cells(), before / 2) << "most of the map lay in the changed tiles";
+  EXPECT_EQ(map.cell(map.index_of(80, 45)), nullptr);
+  EXPECT_EQ(map.cell(far), far_before) << "a tile only the third scan reaches stays as it was";
+  std::size_t reinserted = 0;
+  for (const Placed& s : scans) {
+    if (!changed.reaches(bounds_of(s.in_map))) continue;
+    map.insert_placed_scan(s.in_map, s.at.isometry(), sensor, &changed);
+    ++reinserted;
+  }
+  EXPECT_EQ(reinserted, 4u) << "each scan reaches the tiles the second one lay or lies in";
+  EXPECT_EQ(map.cell(far), far_before);
+
+  MlsMap scratch;
+  for (const Placed& s : scans) scratch.insert_placed_scan(s.in_map, s.at.isometry(), sensor);
+  EXPECT_TRUE(testing_support::same_map(map, scratch));
+  EXPECT_TRUE(testing_support::same_map(scratch, map));
+}
+
+// A scan kept in the map frame goes in as the same scan in its own frame does: the beams that
+// share a fan are still told in the scan's frame, so the ground between them is filled alike.
+TEST(MlsMap, AScanInTheMapFrameFillsTheGroundAsInItsOwnFrame) {
+  World w = load_world(SCANPLAN_SOURCE_DIR "/samples/worlds/yard.json");
+  const RayCaster caster(w);
+  Pose at = w.start;
+  at.yaw = deg2rad(30);
+  at.roll = deg2rad(2);
+  const PointCloud own = simulate_scan(caster, w.scanner, at, 1);
+  const Eigen::Vector3d sensor(0, 0, w.scanner.mount_height_m);
+  PointCloud in_map;
+  const Eigen::Isometry3f T = at.isometry().cast<float>();
+  for (const Eigen::Vector3f& q : own.points) in_map.push_back(T * q, {1, 2, 3});
+  MlsMap from_own, from_map;
+  from_own.insert_scan(own, at.isometry(), sensor);
+  from_map.insert_placed_scan(in_map, at.isometry(), sensor);
+  std::size_t filled = 0;
+  from_own.for_each_cell([&](CellIndex, const MlsCell& c) { filled += c.interpolated; });
+  EXPECT_GT(filled, 100u);
+  EXPECT_TRUE(testing_support::same_map(from_map, from_own));
 }
 
 }  // namespace

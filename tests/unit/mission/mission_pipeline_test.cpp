@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "ground_pose.hpp"
+#include "same_map.hpp"
 #include "scanplan/mission/mission_pipeline.hpp"
 #include "scanplan/sim/simulated_scanner.hpp"
 
@@ -50,6 +51,17 @@ World* MissionPipelineTest::world_ = nullptr;
 RayCaster* MissionPipelineTest::caster_ = nullptr;
 
 constexpr auto* at = &testing_support::ground_pose;
+
+// The MLS map the scans in the mission's map make from scratch, each where its points are.
+MlsMap from_scratch(const MissionPipeline& mission) {
+  MlsMap map(mission.config().mapping.mls);
+  const Eigen::Vector3d sensor(0, 0, mission.config().mapping.sensor_height_m);
+  for (std::size_t i = 0; i < mission.placed_scans().size(); ++i) {
+    if (!mission.in_map(i)) continue;
+    map.insert_placed_scan(*mission.placed_scans()[i], mission.cloud_poses()[i].isometry(), sensor);
+  }
+  return map;
+}
 
 TEST_F(MissionPipelineTest, TheFirstScanDefinesTheMapFrameAndIsNotMatched) {
   MissionPipeline mission(config());
@@ -216,6 +228,10 @@ TEST_F(MissionPipelineTest, TheGraphPlacesAScanTheMapMatchRefused) {
   const PointCloud second = scan_at(at(-5, -9, 0), 2);
   const Eigen::Vector3f moved = mission.poses()[1].isometry().cast<float>() * second.points[0];
   EXPECT_LT((mission.placed_scans()[1]->points[0] - moved).norm(), 1e-3);
+  // The map was made anew only where the second scan now lies, and is what the three scans
+  // make from scratch.
+  EXPECT_TRUE(testing_support::same_map(mission.mapping().map(), from_scratch(mission)));
+  EXPECT_EQ(mission.mapping().scan_poses().size(), 3u);
 }
 
 // The owner (the server's live map) shares each scan's cloud and shows it until the scan moves

@@ -31,6 +31,21 @@ class MappingPipeline {
   // `cloud` in the scan's own frame (origin on the ground under the scanner), in measuring
   // order; `pose` places it in the map.
   InsertStats add_scan(const PointCloud& cloud, const Pose& pose);
+  // The same with the scan's points already in the map frame, placed there at `pose`.
+  InsertStats add_placed_scan(const PointCloud& in_map, const Pose& pose);
+
+  struct PlacedScan {
+    const PointCloud* in_map = nullptr;  // its points in the map frame
+    Pose pose;                           // where they were placed
+    Bounds3 bounds;                      // of in_map
+  };
+  // The map's scans after some moved, left, or joined late: `scans` (in the order they first
+  // came) are all it holds now. Only the tiles reaching `changed` (where the scans that moved or
+  // left lay, where the moved and the late ones lie now) are made anew, from the scans reaching
+  // them; elsewhere the map stands as the same scans built it. The regions and the movable
+  // region follow once, not once a scan: rebuilding a long session's map scan by scan, each
+  // step segmenting the whole map, held the operator up for seconds.
+  void replace_scans(const std::vector<PlacedScan>& scans, const std::vector<Bounds3>& changed);
   void set_target(TargetRegion target);
   // New thresholds for segmentation (completed radius) and the movable region (step height).
   void set_region_configs(const RegionConfig& regions, const MovableConfig& movable);
@@ -45,6 +60,8 @@ class MappingPipeline {
   const PipelineConfig& config() const { return config_; }
 
  private:
+  Eigen::Vector3d sensor() const;  // the laser's centre in a scan's own frame
+  void joined(const Pose& pose);
   void update_regions();
 
   PipelineConfig config_;

@@ -74,6 +74,32 @@ struct InsertStats {
 // consecutive points of a scan (which are neighbours) mostly stay within one tile.
 class MlsMap {
  public:
+  static constexpr int kTileBits = 5;  // 32 × 32 cells a tile
+  static constexpr int kTileSize = 1 << kTileBits;
+
+  // A part of the map in whole tiles, where scans are taken out and put back (clear(), and the
+  // `only` of insert_scan): a cell keeps running statistics of its heights, not the points, so
+  // one scan cannot be subtracted from it.
+  class Tiles {
+   public:
+    // The tiles under the x-y extent of `box` (map frame); an empty box adds none.
+    void add(const Bounds3& box);
+    bool reaches(const Bounds3& box) const;
+    bool contains(std::int32_t tx, std::int32_t ty) const;
+    bool empty() const { return rects_.empty(); }
+
+   private:
+    friend class MlsMap;
+    struct Rect {
+      std::int32_t x0, y0, x1, y1;  // tile indices, inclusive
+    };
+    Tiles(double inv_cell, double max_coordinate_m)
+        : inv_cell_(inv_cell), max_coordinate_m_(max_coordinate_m) {}
+    std::optional<Rect> rect_of(const Bounds3& box) const;
+    double inv_cell_, max_coordinate_m_;
+    std::vector<Rect> rects_;
+  };
+
   explicit MlsMap(MlsConfig config = {});
 
   // Points already in the map frame (after matching). Non-finite points are refused.
@@ -82,8 +108,22 @@ class MlsMap {
   // A whole scan in its sensor's own frame, in the order the scanner measured it (fan by fan),
   // placed by `map_from_scan`; fills the ground between neighbouring returns of a fan (see
   // MlsConfig::fill_between_beams). `sensor_in_scan` is the laser's centre in the scan frame.
+  // With `only`, cells outside those tiles are left as they are.
   InsertStats insert_scan(const PointCloud& scan, const Eigen::Isometry3d& map_from_scan,
-                          const Eigen::Vector3d& sensor_in_scan);
+                          const Eigen::Vector3d& sensor_in_scan, const Tiles* only = nullptr);
+  // The same with the scan's points already in the map frame (placed there by `map_from_scan`),
+  // as the mission keeps them: no copy carried back into the scan's own frame.
+  InsertStats insert_placed_scan(const PointCloud& in_map, const Eigen::Isometry3d& map_from_scan,
+                                 const Eigen::Vector3d& sensor_in_scan,
+                                 const Tiles* only = nullptr);
+
+  // An empty part of the map to fill with Tiles::add.
+  Tiles tiles() const { return Tiles(inv_cell_, config_.max_coordinate_m); }
+  // Empties every cell of `tiles`. Filled again by inserting, restricted to them, each scan that
+  // reaches them in the order the scans first came, they hold what those scans would have made
+  // of an empty map, cell for cell: a cell's state follows from the points that reached it, in
+  // their order.
+  void clear(const Tiles& tiles);
 
   const MlsConfig& config() const { return config_; }
   double cell_m() const { return config_.cell_m; }
@@ -99,19 +139,31 @@ class MlsMap {
   template <typename Fn>
   void for_each_cell(Fn&& fn) const;
 
-  static constexpr int kTileBits = 5;  // 32 × 32 cells a tile
-  static constexpr int kTileSize = 1 << kTileBits;
-
  private:
   struct Tile {
     std::array<MlsCell, kTileSize * kTileSize> cells{};
   };
+  // The tile last written, so that a scan's neighbouring points look their tile up once; and
+  // the tiles writes are restricted to.
+  struct Cursor {
+    const Tiles* only = nullptr;
+    Tile* tile = nullptr;  // null: none yet, or outside `only`
+    std::uint64_t key = 0;
+    bool valid = false;
+  };
   static std::uint64_t tile_key(std::int32_t tx, std::int32_t ty);
-  void insert_point(const Eigen::Vector3f& p, Tile*& cached, std::uint64_t& cached_key);
+  template <bool kPlaced>
+  InsertStats insert_fans(const PointCloud& scan, const Eigen::Isometry3d& map_from_scan,
+                          const Eigen::Vector3d& sensor_in_scan, const Tiles* only);
+  void insert_point(const Eigen::Vector3f& p, Cursor& at);
   void add_to_cell(MlsCell& cell, float z);
-  MlsCell& touch(CellIndex c, Tile*& cached, std::uint64_t& cached_key);
-  void fill_between(const Eigen::Vector3f& a, const Eigen::Vector3f& b, Tile*& cached,
-                    std::uint64_t& cached_key);
+  // The cell, perhaps empty, its tile made if need be; null outside the cursor's `only`.
+  MlsCell* cell_at(CellIndex c, Cursor& at);
+  void enter_tile(std::int32_t tx, std::int32_t ty, Cursor& at);
+  // Counts an empty cell about to be filled.
+  void occupy(CellIndex c);
+  void fill_between(const Eigen::Vector3f& a, const Eigen::Vector3f& b, Cursor& at);
+  void recompute_extent();
 
   MlsConfig config_;
   float gap_;

@@ -212,8 +212,7 @@ class MissionPipeline {
   void follow_graph();
   bool cloud_lags(std::size_t i) const;
   Eigen::Affine3f lag_of(std::size_t i) const;
-  void join_map(const PointCloud& own, std::size_t i);
-  PointCloud own_frame(std::size_t i) const;
+  void join_map(std::size_t i);
   bool reaches(std::size_t i, double x, double y, double radius_m) const;
   std::vector<std::size_t> match_sources(double x, double y, double radius_m) const;
   PointCloud points_of(const std::vector<std::size_t>& scans, double x, double y, double radius_m,

@@ -24,6 +24,8 @@ namespace scanplan {
 class SensorFrame {
  public:
   explicit SensorFrame(PoseNoise noise = {}) : noise_(noise) {}
+  // Fitted once to every scan whose map pose is known (add() refits with each).
+  SensorFrame(PoseNoise noise, std::vector<Pose> reported, std::vector<Pose> placed);
 
   // One scan whose map pose is known: the first, or one placed by a believed match.
   void add(const Pose& reported, const Pose& placed);

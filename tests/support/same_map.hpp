@@ -1,0 +1,46 @@
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "scanplan/mapping/mls_map.hpp"
+
+namespace scanplan::testing_support {
+
+// Whether two MLS maps hold the same cells with the same surfaces, bit for bit: a map made anew
+// in parts must be the map the same scans make from scratch.
+inline ::testing::AssertionResult same_map(const MlsMap& a, const MlsMap& b) {
+  if (a.occupied_cells() != b.occupied_cells()) {
+    return ::testing::AssertionFailure()
+           << a.occupied_cells() << " occupied cells against " << b.occupied_cells();
+  }
+  if (a.extent() != b.extent()) return ::testing::AssertionFailure() << "the extents differ";
+  std::string first_difference;
+  a.for_each_cell([&](CellIndex c, const MlsCell& x) {
+    if (!first_difference.empty()) return;
+    const MlsCell* y = b.cell(c);
+    const std::string at = "cell (" + std::to_string(c.x) + ", " + std::to_string(c.y) + ")";
+    if (!y) {
+      first_difference = at + " is empty in the second map";
+      return;
+    }
+    if (x.size != y->size || x.interpolated != y->interpolated) {
+      first_difference = at + " holds other surfaces";
+      return;
+    }
+    for (int k = 0; k < x.size; ++k) {
+      const SurfacePatch& p = x.patches[k];
+      const SurfacePatch& q = y->patches[k];
+      if (p.min_z != q.min_z || p.max_z != q.max_z || p.mean_z != q.mean_z || p.m2 != q.m2 ||
+          p.count != q.count) {
+        first_difference = at + ", surface " + std::to_string(k) + " differs";
+        return;
+      }
+    }
+  });
+  if (!first_difference.empty()) return ::testing::AssertionFailure() << first_difference;
+  return ::testing::AssertionSuccess();
+}
+
+}  // namespace scanplan::testing_support
