@@ -72,7 +72,7 @@ std::vector<Scan> simulate_session(const World& world, std::size_t n) {
 
 std::vector<MappingPipeline::PlacedScan> placed(const std::vector<Scan>& scans) {
   std::vector<MappingPipeline::PlacedScan> out;
-  for (const Scan& s : scans) out.push_back({&s.in_map, s.at, s.bounds});
+  for (const Scan& s : scans) out.push_back({&s.in_map, s.at, s.at, s.bounds});
   return out;
 }
 
@@ -131,7 +131,7 @@ int main(int argc, char** argv) {
 
   const auto built = [&](const std::vector<Scan>& from) {
     auto m = std::make_unique<MappingPipeline>(config);
-    for (const Scan& s : from) m->add_placed_scan(s.in_map, s.at);
+    for (const Scan& s : from) m->add_placed_scan(s.in_map, s.at, s.at);
     return m;
   };
   constexpr int kRepeats = 3;

@@ -10,8 +10,10 @@ InsertStats MappingPipeline::add_scan(const PointCloud& cloud, const Pose& pose)
   return stats;
 }
 
-InsertStats MappingPipeline::add_placed_scan(const PointCloud& in_map, const Pose& pose) {
-  const InsertStats stats = map_.insert_placed_scan(in_map, pose.isometry(), sensor());
+InsertStats MappingPipeline::add_placed_scan(const PointCloud& in_map, const Pose& placed_at,
+                                             const Pose& pose) {
+  const InsertStats stats =
+      map_.insert_placed_scan(in_map, placed_at.isometry(), pose.isometry(), sensor());
   joined(pose);
   return stats;
 }
@@ -26,7 +28,8 @@ void MappingPipeline::replace_scans(const std::vector<PlacedScan>& scans,
     map_.clear(tiles);
     for (const PlacedScan& s : scans) {
       if (tiles.reaches(s.bounds)) {
-        map_.insert_placed_scan(*s.in_map, s.pose.isometry(), sensor(), &tiles);
+        map_.insert_placed_scan(*s.in_map, s.placed_at.isometry(), s.pose.isometry(), sensor(),
+                                &tiles);
       }
     }
   }

@@ -137,24 +137,32 @@ void MlsMap::occupy(CellIndex c) {
 
 InsertStats MlsMap::insert_scan(const PointCloud& scan, const Eigen::Isometry3d& map_from_scan,
                                 const Eigen::Vector3d& sensor_in_scan, const Tiles* only) {
-  return insert_fans<false>(scan, map_from_scan, sensor_in_scan, only);
+  return insert_fans<false>(scan, nullptr, map_from_scan, sensor_in_scan, only);
 }
 
-InsertStats MlsMap::insert_placed_scan(const PointCloud& in_map,
+InsertStats MlsMap::insert_placed_scan(const PointCloud& in_map, const Eigen::Isometry3d& placed_at,
                                        const Eigen::Isometry3d& map_from_scan,
                                        const Eigen::Vector3d& sensor_in_scan, const Tiles* only) {
-  return insert_fans<true>(in_map, map_from_scan, sensor_in_scan, only);
+  if (placed_at.matrix() == map_from_scan.matrix()) {
+    return insert_fans<true>(in_map, nullptr, map_from_scan, sensor_in_scan, only);
+  }
+  return insert_fans<true>(in_map, &placed_at, map_from_scan, sensor_in_scan, only);
 }
 
-// kPlaced: the points are in the map frame already; which beams share a fan is still judged in
-// the scan's own frame, where a fan is a vertical half-plane.
+// kPlaced: the points are in the map frame already (moved from `placed_at` to `map_from_scan`
+// when given); which beams share a fan is still judged in the scan's own frame, where a fan is a
+// vertical half-plane.
 template <bool kPlaced>
-InsertStats MlsMap::insert_fans(const PointCloud& scan, const Eigen::Isometry3d& map_from_scan,
+InsertStats MlsMap::insert_fans(const PointCloud& scan, const Eigen::Isometry3d* placed_at,
+                                const Eigen::Isometry3d& map_from_scan,
                                 const Eigen::Vector3d& sensor_in_scan, const Tiles* only) {
   InsertStats stats;
   Cursor at;
   at.only = only;
   const Eigen::Isometry3f T = map_from_scan.cast<float>();
+  const Eigen::Isometry3f lag =
+      placed_at ? Eigen::Isometry3f((map_from_scan * placed_at->inverse()).cast<float>())
+                : Eigen::Isometry3f::Identity();
   const Eigen::Isometry3f T_inverse = map_from_scan.inverse().cast<float>();
   const Eigen::Vector3f sensor = sensor_in_scan.cast<float>();
   const float limit = static_cast<float>(config_.max_coordinate_m);
@@ -166,8 +174,9 @@ InsertStats MlsMap::insert_fans(const PointCloud& scan, const Eigen::Isometry3d&
     float horizontal;
     bool usable;
   };
-  const auto beam_of = [&](const Eigen::Vector3f& point) {
-    const Eigen::Vector3f p = kPlaced ? Eigen::Vector3f(T_inverse * point) : point;
+  // `point` as given, `q` where it goes in the map.
+  const auto beam_of = [&](const Eigen::Vector3f& point, const Eigen::Vector3f& q) {
+    const Eigen::Vector3f p = kPlaced ? Eigen::Vector3f(T_inverse * q) : point;
     Beam b{p - sensor, 0, false};
     b.horizontal = std::sqrt(b.d.x() * b.d.x() + b.d.y() * b.d.y());  // never near overflow
     b.usable = b.d.z() < -1e-3f * b.horizontal && b.horizontal > 0.3f;
@@ -180,7 +189,8 @@ InsertStats MlsMap::insert_fans(const PointCloud& scan, const Eigen::Isometry3d&
   std::uint64_t prev_key = 0;
   bool prev_outside = false;
   for (const Eigen::Vector3f& point : scan.points) {
-    const Eigen::Vector3f q = kPlaced ? point : Eigen::Vector3f(T * point);
+    const Eigen::Vector3f q =
+        kPlaced ? (placed_at ? Eigen::Vector3f(lag * point) : point) : Eigen::Vector3f(T * point);
     if (!(std::abs(q.x()) < limit && std::abs(q.y()) < limit && std::abs(q.z()) < limit)) {
       ++stats.rejected;
       prev = nullptr;
@@ -196,9 +206,9 @@ InsertStats MlsMap::insert_fans(const PointCloud& scan, const Eigen::Isometry3d&
     if (prev && outside && prev_outside && key == prev_key) {
       prev_beam.reset();
     } else {
-      const Beam beam = beam_of(point);
+      const Beam beam = beam_of(point, q);
       if (prev && beam.usable) {
-        if (!prev_beam) prev_beam = beam_of(*prev);
+        if (!prev_beam) prev_beam = beam_of(*prev, prev_map);
         const Beam& b = *prev_beam;
         const float cos_az =
             (beam.d.x() * b.d.x() + beam.d.y() * b.d.y()) / (beam.horizontal * b.horizontal);

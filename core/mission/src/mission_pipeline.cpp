@@ -143,6 +143,7 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
   reported_.push_back(where.reported);
   poses_.push_back(where.placed);
   cloud_poses_.push_back(where.placed);
+  map_poses_.push_back(where.placed);
   anchored_near_.push_back(0);
   in_map_.push_back(0);
   goals_.push_back(where.goal);
@@ -170,14 +171,16 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
   last_correction_->graph_ms = ms_between(t0, t1) + ms_between(t2, t3);
 }
 
-// The map holds the scan where its points are (cloud_poses_).
+// The map holds the scan where the graph has it, its points moved there on the way in.
 void MissionPipeline::join_map(std::size_t i) {
-  mapping_.add_placed_scan(*placed_[i], cloud_poses_[i]);
+  map_poses_[i] = poses_[i];
+  mapping_.add_placed_scan(*placed_[i], cloud_poses_[i], map_poses_[i]);
   in_map_[i] = 1;
   if (anchored_[i]) {
     sensor_frame_.add(reported_[i], poses_[i]);
     if (anchored_map_) {
       anchored_map_->insert_placed_scan(*placed_[i], cloud_poses_[i].isometry(),
+                                        map_poses_[i].isometry(),
                                         Eigen::Vector3d(0, 0, config_.mapping.sensor_height_m));
     }
   }
@@ -302,35 +305,25 @@ MapCorrection MissionPipeline::correction(const GraphUpdate& update,
   return c;
 }
 
-// The map follows the graph: the anchored scans are in it, at the graph's poses. The newest
-// scan joins as usual; an older one that was anchored late, one that lost its anchoring, or one
-// that moved far enough to matter has the map rebuilt.
+// The map follows the graph: the anchored scans are in it, near the graph's poses. Each scan's
+// points follow past replace_m / _deg; the MLS map is made anew where an older scan moved past
+// remap_m / _deg, was anchored late or lost its anchoring; else the newest joins as usual.
 void MissionPipeline::follow_graph() {
   const std::size_t newest = placed_.size() - 1;
-  bool rebuild = false;
+  poses_ = graph_->poses();
+  bool remap = false;
   for (std::size_t i = 0; i < placed_.size(); ++i) {
     anchored_[i] = graph_->anchored(i) ? 1 : 0;
-    const Pose& now = graph_->poses()[i];
-    // Against the map as it stands, not the graph's previous estimate: small moves add up.
-    const PoseChange d = change(poses_[i], now);
-    if (in_map_[i] &&
-        (!anchored_[i] || d.metres > config_.replace_m || d.degrees > config_.replace_deg)) {
-      rebuild = true;
-    }
-    if (!in_map_[i] && anchored_[i] && i != newest) rebuild = true;
-    if (!in_map_[i]) poses_[i] = now;
-  }
-  if (rebuild) {
-    poses_ = graph_->poses();
-    replace();
-    return;
-  }
-  // The points shown follow the graph wherever the scan is, in the map or not; the newest
-  // before it joins, as the map holds a scan where its points are.
-  for (std::size_t i = 0; i < placed_.size(); ++i) {
+    if (in_map_[i] && (!anchored_[i] || map_lags(i))) remap = true;
+    if (!in_map_[i] && anchored_[i] && i != newest) remap = true;
+    // The points shown follow the graph wherever the scan is, in the map or not.
     if (cloud_lags(i)) set_cloud(i, std::make_shared<const PointCloud>(at_estimate(i)));
   }
-  if (anchored_[newest] && !in_map_[newest]) join_map(newest);
+  if (remap) {
+    replace();
+  } else if (anchored_[newest] && !in_map_[newest]) {
+    join_map(newest);
+  }
 }
 
 // A scan's points are made anew in the map frame only when the graph moved it past replace_m /
@@ -341,6 +334,12 @@ void MissionPipeline::follow_graph() {
 bool MissionPipeline::cloud_lags(std::size_t i) const {
   const PoseChange d = change(cloud_poses_[i], poses_[i]);
   return d.metres > config_.replace_m || d.degrees > config_.replace_deg;
+}
+
+// Against where the map holds it, not the graph's previous estimate: small moves add up.
+bool MissionPipeline::map_lags(std::size_t i) const {
+  const PoseChange d = change(map_poses_[i], poses_[i]);
+  return d.metres > config_.remap_m || d.degrees > config_.remap_deg;
 }
 
 Eigen::Affine3f MissionPipeline::lag_of(std::size_t i) const {
@@ -354,23 +353,41 @@ PointCloud MissionPipeline::at_estimate(std::size_t i) const {
   return out;
 }
 
-// The map follows the graph: the scans that moved past replace_m / _deg get their points anew
-// and, with those that left the map or joined it late, have the MLS map made anew where they lay
-// and where they lie; the rest of the map stands (MappingPipeline::replace_scans). The map holds
-// each scan where its points are (cloud_poses()). Only with the graph, whose map is the anchored
-// one (no anchored_map_ of its own).
+// The scan as the MLS map holds it: its points moved from where they were placed to its map
+// pose, and their bounds there.
+MappingPipeline::PlacedScan MissionPipeline::as_mapped(std::size_t i) const {
+  MappingPipeline::PlacedScan s{placed_[i].get(), cloud_poses_[i], map_poses_[i], cloud_bounds_[i]};
+  if (cloud_poses_[i].isometry().matrix() == map_poses_[i].isometry().matrix()) return s;
+  const Eigen::Isometry3f lag =
+      (map_poses_[i].isometry() * cloud_poses_[i].isometry().inverse()).cast<float>();
+  const Bounds3& b = cloud_bounds_[i];
+  s.bounds = Bounds3{};
+  for (int corner = 0; corner < 8; ++corner) {
+    s.bounds.extend(lag * Eigen::Vector3f(corner & 1 ? b.max.x() : b.min.x(),
+                                          corner & 2 ? b.max.y() : b.min.y(),
+                                          corner & 4 ? b.max.z() : b.min.z()));
+  }
+  return s;
+}
+
+// The MLS map made anew where scans moved past remap_m / _deg, left it or joined it late: where
+// they lay and where they now lie (at the graph's estimate); the rest of it stands
+// (MappingPipeline::replace_scans). Only with the graph, whose map is the anchored one (no
+// anchored_map_ of its own).
 void MissionPipeline::replace() {
   std::vector<Bounds3> changed;
   std::vector<MappingPipeline::PlacedScan> in_map;
   std::vector<Pose> reported, placed;
   for (std::size_t i = 0; i < placed_.size(); ++i) {
-    const bool lags = cloud_lags(i);
-    if (in_map_[i] && (lags || !anchored_[i])) changed.push_back(cloud_bounds_[i]);
-    if (lags) set_cloud(i, std::make_shared<const PointCloud>(at_estimate(i)));
-    if (anchored_[i] && (lags || !in_map_[i])) changed.push_back(cloud_bounds_[i]);
+    const bool lags = map_lags(i);
+    if (in_map_[i] && (lags || !anchored_[i])) changed.push_back(as_mapped(i).bounds);
+    if (anchored_[i] && (lags || !in_map_[i])) {
+      map_poses_[i] = poses_[i];
+      changed.push_back(as_mapped(i).bounds);
+    }
     in_map_[i] = anchored_[i];
     if (!anchored_[i]) continue;
-    in_map.push_back({placed_[i].get(), cloud_poses_[i], cloud_bounds_[i]});
+    in_map.push_back(as_mapped(i));
     reported.push_back(reported_[i]);
     placed.push_back(poses_[i]);
   }

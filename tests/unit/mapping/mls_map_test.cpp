@@ -161,7 +161,8 @@ TEST(MlsMap, ClearedTilesFilledAgainAreTheMapTheScansMakeFromScratch) {
   std::vector<Placed> scans = {scan_at(40, 60, 0, 1), scan_at(80, 45, 10, 2),
                                scan_at(150, 90, 0, 3), scan_at(120, 10, 0, 4)};
   MlsMap map;
-  for (const Placed& s : scans) map.insert_placed_scan(s.in_map, s.at.isometry(), sensor);
+  for (const Placed& s : scans)
+    map.insert_placed_scan(s.in_map, s.at.isometry(), s.at.isometry(), sensor);
   const CellIndex far = map.index_of(170, 95);
   const MlsCell* far_before = map.cell(far);
   ASSERT_NE(far_before, nullptr);
@@ -184,14 +185,15 @@ TEST(MlsMap, ClearedTilesFilledAgainAreTheMapTheScansMakeFromScratch) {
   std::size_t reinserted = 0;
   for (const Placed& s : scans) {
     if (!changed.reaches(bounds_of(s.in_map))) continue;
-    map.insert_placed_scan(s.in_map, s.at.isometry(), sensor, &changed);
+    map.insert_placed_scan(s.in_map, s.at.isometry(), s.at.isometry(), sensor, &changed);
     ++reinserted;
   }
   EXPECT_EQ(reinserted, 4u) << "each scan reaches the tiles the second one lay or lies in";
   EXPECT_EQ(map.cell(far), far_before);
 
   MlsMap scratch;
-  for (const Placed& s : scans) scratch.insert_placed_scan(s.in_map, s.at.isometry(), sensor);
+  for (const Placed& s : scans)
+    scratch.insert_placed_scan(s.in_map, s.at.isometry(), s.at.isometry(), sensor);
   EXPECT_TRUE(testing_support::same_map(map, scratch));
   EXPECT_TRUE(testing_support::same_map(scratch, map));
 }
@@ -211,7 +213,7 @@ TEST(MlsMap, AScanInTheMapFrameFillsTheGroundAsInItsOwnFrame) {
   for (const Eigen::Vector3f& q : own.points) in_map.push_back(T * q, {1, 2, 3});
   MlsMap from_own, from_map;
   from_own.insert_scan(own, at.isometry(), sensor);
-  from_map.insert_placed_scan(in_map, at.isometry(), sensor);
+  from_map.insert_placed_scan(in_map, at.isometry(), at.isometry(), sensor);
   std::size_t filled = 0;
   from_own.for_each_cell([&](CellIndex, const MlsCell& c) { filled += c.interpolated; });
   EXPECT_GT(filled, 100u);

@@ -31,13 +31,15 @@ class MappingPipeline {
   // `cloud` in the scan's own frame (origin on the ground under the scanner), in measuring
   // order; `pose` places it in the map.
   InsertStats add_scan(const PointCloud& cloud, const Pose& pose);
-  // The same with the scan's points already in the map frame, placed there at `pose`.
-  InsertStats add_placed_scan(const PointCloud& in_map, const Pose& pose);
+  // The same with the scan's points already in the map frame, as placed at `placed_at`; the map
+  // holds them moved to `pose`.
+  InsertStats add_placed_scan(const PointCloud& in_map, const Pose& placed_at, const Pose& pose);
 
   struct PlacedScan {
-    const PointCloud* in_map = nullptr;  // its points in the map frame
-    Pose pose;                           // where they were placed
-    Bounds3 bounds;                      // of in_map
+    const PointCloud* in_map = nullptr;  // its points in the map frame, placed at `placed_at`
+    Pose placed_at;
+    Pose pose;       // where the map holds the scan (its points moved there from placed_at)
+    Bounds3 bounds;  // of its points as the map holds them
   };
   // The map's scans after some moved, left, or joined late: `scans` (in the order they first
   // came) are all it holds now. Only the tiles reaching `changed` (where the scans that moved or

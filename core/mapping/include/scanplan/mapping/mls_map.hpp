@@ -111,9 +111,11 @@ class MlsMap {
   // With `only`, cells outside those tiles are left as they are.
   InsertStats insert_scan(const PointCloud& scan, const Eigen::Isometry3d& map_from_scan,
                           const Eigen::Vector3d& sensor_in_scan, const Tiles* only = nullptr);
-  // The same with the scan's points already in the map frame (placed there by `map_from_scan`),
-  // as the mission keeps them: no copy carried back into the scan's own frame.
-  InsertStats insert_placed_scan(const PointCloud& in_map, const Eigen::Isometry3d& map_from_scan,
+  // The same with the scan's points already in the map frame, as placed at `placed_at` (the
+  // mission keeps them so), put where `map_from_scan` places the scan: moved on the fly, no copy
+  // carried back into the scan's own frame.
+  InsertStats insert_placed_scan(const PointCloud& in_map, const Eigen::Isometry3d& placed_at,
+                                 const Eigen::Isometry3d& map_from_scan,
                                  const Eigen::Vector3d& sensor_in_scan,
                                  const Tiles* only = nullptr);
 
@@ -152,8 +154,10 @@ class MlsMap {
     bool valid = false;
   };
   static std::uint64_t tile_key(std::int32_t tx, std::int32_t ty);
+  // `placed_at`: where the points were placed in the map frame; nothing: in the scan's frame.
   template <bool kPlaced>
-  InsertStats insert_fans(const PointCloud& scan, const Eigen::Isometry3d& map_from_scan,
+  InsertStats insert_fans(const PointCloud& scan, const Eigen::Isometry3d* placed_at,
+                          const Eigen::Isometry3d& map_from_scan,
                           const Eigen::Vector3d& sensor_in_scan, const Tiles* only);
   void insert_point(const Eigen::Vector3f& p, Cursor& at);
   void add_to_cell(MlsCell& cell, float z);

@@ -35,19 +35,24 @@ struct MissionConfig {
   // The pose graph over the scans (issue 17), used while matching is on; nothing: each scan
   // stays where its match to the map put it.
   std::optional<ScanGraphConfig> graph = ScanGraphConfig{};
-  // When the graph moves any scan farther than this, the map is rebuilt at the new poses (the
-  // MLS map's cells are 1 m; a smaller correction changes nothing an operator or the planner
-  // can see).
+  // When the graph moves a scan farther than this, its points are made anew in the map frame
+  // (placed_scans(); what the operator sees and the owner re-sends).
   double replace_m = 0.02;
   double replace_deg = 0.05;
+  // When the graph moves a scan in the MLS map farther than this, the map is made anew where the
+  // scan lay and lies (the map's cells are 1 m, the movable region's steps 15 cm: a smaller
+  // correction changes nothing the planner sees, and a long session's map took seconds to make
+  // anew for 2 cm moves; issue 19).
+  double remap_m = 0.05;
+  double remap_deg = 0.1;
 };
 
 // How the map changed when the graph moved scans after the latest one joined.
 struct MapCorrection {
   GraphUpdate graph;
-  // The scans (in joining order) whose pose in the map moved more than 5 mm or 0.01°; the map
-  // is rebuilt only when one moves past MissionConfig::replace_m / _deg, so smaller moves wait
-  // until they add up.
+  // The scans (in joining order) whose pose (the graph's estimate, poses()) moved more than
+  // 5 mm or 0.01°; their points and the MLS map follow past MissionConfig::replace_m and remap_m,
+  // so smaller moves wait until they add up.
   std::vector<std::size_t> moved;
   double max_moved_m = 0, max_turned_deg = 0;
   // How long the graph took over the scan (wall clock): its pairs, the refused scans matched
@@ -150,6 +155,9 @@ class MissionPipeline {
   // graph's estimate (poses()) moves them anew only past MissionConfig::replace_m / _deg.
   const std::vector<std::shared_ptr<const PointCloud>>& placed_scans() const { return placed_; }
   const std::vector<Pose>& cloud_poses() const { return cloud_poses_; }
+  // Where the MLS map holds each scan (in_map()): the graph's estimate when it last moved past
+  // MissionConfig::remap_m / _deg; its points moved there from cloud_poses().
+  const std::vector<Pose>& map_poses() const { return map_poses_; }
   // The i-th scan's points at the graph's estimate (a copy).
   PointCloud at_estimate(std::size_t i) const;
   const MappingPipeline& mapping() const { return mapping_; }
@@ -179,6 +187,7 @@ class MissionPipeline {
   std::vector<Pose> reported_;         // per scan, for refitting sensor_frame_
   std::vector<Pose> poses_;            // per scan: where it is (the graph's estimate)
   std::vector<Pose> cloud_poses_;      // per scan: the pose its placed_ points were put at
+  std::vector<Pose> map_poses_;        // per scan: where the MLS map holds it
   std::vector<Bounds3> cloud_bounds_;  // per scan: its placed_ points' bounds
   std::vector<std::uint8_t> in_map_;
   std::vector<std::optional<Eigen::Vector3d>> goals_;  // per scan: Placement::goal
@@ -211,6 +220,8 @@ class MissionPipeline {
   bool beyond_reach(const MoveUncertainty& u) const;
   void follow_graph();
   bool cloud_lags(std::size_t i) const;
+  bool map_lags(std::size_t i) const;
+  MappingPipeline::PlacedScan as_mapped(std::size_t i) const;
   Eigen::Affine3f lag_of(std::size_t i) const;
   void join_map(std::size_t i);
   bool reaches(std::size_t i, double x, double y, double radius_m) const;
