@@ -171,8 +171,10 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
   last_correction_->graph_ms = ms_between(t0, t1) + ms_between(t2, t3);
 }
 
-// The map holds the scan where the graph has it, its points moved there on the way in.
+// The map holds the scan where the graph has it, its points moved there on the way in; after
+// every scan already in it, whenever it was taken (map_order()).
 void MissionPipeline::join_map(std::size_t i) {
+  map_order_.push_back(i);
   map_poses_[i] = poses_[i];
   mapping_.add_placed_scan(*placed_[i], cloud_poses_[i], map_poses_[i]);
   in_map_[i] = 1;
@@ -306,23 +308,20 @@ MapCorrection MissionPipeline::correction(const GraphUpdate& update,
 }
 
 // The map follows the graph: the anchored scans are in it, near the graph's poses. Each scan's
-// points follow past replace_m / _deg; the MLS map is made anew where an older scan moved past
-// remap_m / _deg, was anchored late or lost its anchoring; else the newest joins as usual.
+// points follow past replace_m / _deg; the MLS map is made anew where a scan in it moved past
+// remap_m / _deg or lost its anchoring; scans anchored now, the newest or older ones, join it.
 void MissionPipeline::follow_graph() {
-  const std::size_t newest = placed_.size() - 1;
   poses_ = graph_->poses();
   bool remap = false;
   for (std::size_t i = 0; i < placed_.size(); ++i) {
     anchored_[i] = graph_->anchored(i) ? 1 : 0;
     if (in_map_[i] && (!anchored_[i] || map_lags(i))) remap = true;
-    if (!in_map_[i] && anchored_[i] && i != newest) remap = true;
     // The points shown follow the graph wherever the scan is, in the map or not.
     if (cloud_lags(i)) set_cloud(i, std::make_shared<const PointCloud>(at_estimate(i)));
   }
-  if (remap) {
-    replace();
-  } else if (anchored_[newest] && !in_map_[newest]) {
-    join_map(newest);
+  if (remap) replace();
+  for (std::size_t i = 0; i < placed_.size(); ++i) {
+    if (anchored_[i] && !in_map_[i]) join_map(i);
   }
 }
 
@@ -370,28 +369,34 @@ MappingPipeline::PlacedScan MissionPipeline::as_mapped(std::size_t i) const {
   return s;
 }
 
-// The MLS map made anew where scans moved past remap_m / _deg, left it or joined it late: where
-// they lay and where they now lie (at the graph's estimate); the rest of it stands
+// The MLS map made anew where scans in it moved past remap_m / _deg or left it: where they lay
+// and where they now lie (at the graph's estimate); the rest of it stands
 // (MappingPipeline::replace_scans). Only with the graph, whose map is the anchored one (no
 // anchored_map_ of its own).
 void MissionPipeline::replace() {
   std::vector<Bounds3> changed;
-  std::vector<MappingPipeline::PlacedScan> in_map;
+  std::vector<MappingPipeline::PlacedScan> stay;
+  std::vector<std::size_t> order;
   std::vector<Pose> reported, placed;
-  for (std::size_t i = 0; i < placed_.size(); ++i) {
-    const bool lags = map_lags(i);
-    if (in_map_[i] && (lags || !anchored_[i])) changed.push_back(as_mapped(i).bounds);
-    if (anchored_[i] && (lags || !in_map_[i])) {
+  for (const std::size_t i : map_order_) {
+    changed.push_back(as_mapped(i).bounds);  // where it lay
+    if (!anchored_[i]) {
+      in_map_[i] = 0;
+      continue;
+    }
+    if (map_lags(i)) {
       map_poses_[i] = poses_[i];
       changed.push_back(as_mapped(i).bounds);
+    } else {
+      changed.pop_back();  // it stays where it lay
     }
-    in_map_[i] = anchored_[i];
-    if (!anchored_[i]) continue;
-    in_map.push_back(as_mapped(i));
+    stay.push_back(as_mapped(i));
+    order.push_back(i);
     reported.push_back(reported_[i]);
     placed.push_back(poses_[i]);
   }
-  mapping_.replace_scans(in_map, changed);
+  map_order_ = std::move(order);
+  mapping_.replace_scans(stay, changed);
   sensor_frame_ = SensorFrame(config_.pose_noise, std::move(reported), std::move(placed));
 }
 

@@ -74,11 +74,10 @@ Drive drive_loop(bool graph_on, int threads = 0, double drift_factor = 1) {
     if (const auto& c = mission.last_correction()) {
       out.corrected.push_back(c->moved.size());
       out.pairs += c->graph.pairs_tried + c->graph.rematches_tried;
-      // Made anew only where scans moved, the map is what its scans make from scratch where it
-      // holds them.
+      // Made anew only where scans moved, the map is what its scans make from scratch, in the
+      // order they entered it, where it holds them.
       MlsMap scratch(config.mapping.mls);
-      for (std::size_t i = 0; i <= k; ++i) {
-        if (!mission.in_map(i)) continue;
+      for (const std::size_t i : mission.map_order()) {
         scratch.insert_placed_scan(*mission.placed_scans()[i], mission.cloud_poses()[i].isometry(),
                                    mission.map_poses()[i].isometry(),
                                    Eigen::Vector3d(0, 0, config.mapping.sensor_height_m));

@@ -52,12 +52,12 @@ RayCaster* MissionPipelineTest::caster_ = nullptr;
 
 constexpr auto* at = &testing_support::ground_pose;
 
-// The MLS map the scans in the mission's map make from scratch, each where the map holds it.
+// The MLS map the scans in the mission's map make from scratch, in the order they entered it,
+// each where the map holds it.
 MlsMap from_scratch(const MissionPipeline& mission) {
   MlsMap map(mission.config().mapping.mls);
   const Eigen::Vector3d sensor(0, 0, mission.config().mapping.sensor_height_m);
-  for (std::size_t i = 0; i < mission.placed_scans().size(); ++i) {
-    if (!mission.in_map(i)) continue;
+  for (const std::size_t i : mission.map_order()) {
     map.insert_placed_scan(*mission.placed_scans()[i], mission.cloud_poses()[i].isometry(),
                            mission.map_poses()[i].isometry(), sensor);
   }
@@ -229,8 +229,8 @@ TEST_F(MissionPipelineTest, TheGraphPlacesAScanTheMapMatchRefused) {
   const PointCloud second = scan_at(at(-5, -9, 0), 2);
   const Eigen::Vector3f moved = mission.poses()[1].isometry().cast<float>() * second.points[0];
   EXPECT_LT((mission.placed_scans()[1]->points[0] - moved).norm(), 1e-3);
-  // The map was made anew only where the second scan now lies, and is what the three scans
-  // make from scratch.
+  // The second scan joined the map with the third, and the map is what the three make from
+  // scratch.
   EXPECT_TRUE(testing_support::same_map(mission.mapping().map(), from_scratch(mission), 1e-4F));
   EXPECT_EQ(mission.mapping().scan_poses().size(), 3u);
 }

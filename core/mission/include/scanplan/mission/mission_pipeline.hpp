@@ -158,6 +158,9 @@ class MissionPipeline {
   // Where the MLS map holds each scan (in_map()): the graph's estimate when it last moved past
   // MissionConfig::remap_m / _deg; its points moved there from cloud_poses().
   const std::vector<Pose>& map_poses() const { return map_poses_; }
+  // The scans in the MLS map in the order they entered it (a scan anchored late enters after the
+  // ones already there): the map is what they make from scratch in that order.
+  const std::vector<std::size_t>& map_order() const { return map_order_; }
   // The i-th scan's points at the graph's estimate (a copy).
   PointCloud at_estimate(std::size_t i) const;
   const MappingPipeline& mapping() const { return mapping_; }
@@ -184,10 +187,11 @@ class MissionPipeline {
   // kept only while matching is on.
   std::optional<MlsMap> anchored_map_;
   SensorFrame sensor_frame_;
-  std::vector<Pose> reported_;         // per scan, for refitting sensor_frame_
-  std::vector<Pose> poses_;            // per scan: where it is (the graph's estimate)
-  std::vector<Pose> cloud_poses_;      // per scan: the pose its placed_ points were put at
-  std::vector<Pose> map_poses_;        // per scan: where the MLS map holds it
+  std::vector<Pose> reported_;     // per scan, for refitting sensor_frame_
+  std::vector<Pose> poses_;        // per scan: where it is (the graph's estimate)
+  std::vector<Pose> cloud_poses_;  // per scan: the pose its placed_ points were put at
+  std::vector<Pose> map_poses_;    // per scan: where the MLS map holds it
+  std::vector<std::size_t> map_order_;
   std::vector<Bounds3> cloud_bounds_;  // per scan: its placed_ points' bounds
   std::vector<std::uint8_t> in_map_;
   std::vector<std::optional<Eigen::Vector3d>> goals_;  // per scan: Placement::goal
