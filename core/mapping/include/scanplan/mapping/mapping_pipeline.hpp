@@ -41,8 +41,8 @@ class MappingPipeline {
     Pose pose;       // where the map holds the scan (its points moved there from placed_at)
     Bounds3 bounds;  // of its points as the map holds them
   };
-  // The map's scans after some moved, left, or joined late: `scans` (in the order they first
-  // came) are all it holds now. Only the tiles reaching `changed` (where the scans that moved or
+  // The map's scans after some moved, left, or joined late: `scans` (in the order the map took
+  // them) are all it holds now. Only the tiles reaching `changed` (where the scans that moved or
   // left lay, where the moved and the late ones lie now) are made anew, from the scans reaching
   // them; elsewhere the map stands as the same scans built it. The regions and the movable
   // region follow once, not once a scan: rebuilding a long session's map scan by scan, each

@@ -122,9 +122,9 @@ class MlsMap {
   // An empty part of the map to fill with Tiles::add.
   Tiles tiles() const { return Tiles(inv_cell_, config_.max_coordinate_m); }
   // Empties every cell of `tiles`. Filled again by inserting, restricted to them, each scan that
-  // reaches them in the order the scans first came, they hold what those scans would have made
-  // of an empty map, cell for cell: a cell's state follows from the points that reached it, in
-  // their order.
+  // reaches them in the order the scans first went in, they hold what those scans would have
+  // made of an empty map, cell for cell: a cell's state follows from the points that reached it,
+  // in their order.
   void clear(const Tiles& tiles);
 
   const MlsConfig& config() const { return config_; }
