@@ -163,7 +163,7 @@ int main(int argc, char** argv) {
       for (std::size_t i = 0; i < s.in_map.size(); ++i) {
         own.push_back(own_from_map * s.in_map.points[i], s.in_map.colors[i]);
       }
-      baseline->add_scan(own, s.at);
+      baseline->add_placed_scan(own, Pose{}, s.at);
     }
     best_baseline = std::min(best_baseline, ms_since(t1));
   }

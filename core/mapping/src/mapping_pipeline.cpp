@@ -4,12 +4,6 @@ namespace scanplan {
 
 MappingPipeline::MappingPipeline(PipelineConfig config) : config_(config), map_(config.mls) {}
 
-InsertStats MappingPipeline::add_scan(const PointCloud& cloud, const Pose& pose) {
-  const InsertStats stats = map_.insert_scan(cloud, pose.isometry(), sensor());
-  joined(pose);
-  return stats;
-}
-
 InsertStats MappingPipeline::add_placed_scan(const PointCloud& in_map, const Pose& placed_at,
                                              const Pose& pose) {
   const InsertStats stats =

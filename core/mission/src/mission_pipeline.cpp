@@ -379,18 +379,15 @@ void MissionPipeline::replace() {
   std::vector<std::size_t> order;
   std::vector<Pose> reported, placed;
   for (const std::size_t i : map_order_) {
-    changed.push_back(as_mapped(i).bounds);  // where it lay
-    if (!anchored_[i]) {
+    const bool left = !anchored_[i], moved = !left && map_lags(i);
+    if (left || moved) changed.push_back(as_mapped(i).bounds);  // where it lay
+    if (left) {
       in_map_[i] = 0;
       continue;
     }
-    if (map_lags(i)) {
-      map_poses_[i] = poses_[i];
-      changed.push_back(as_mapped(i).bounds);
-    } else {
-      changed.pop_back();  // it stays where it lay
-    }
+    if (moved) map_poses_[i] = poses_[i];
     stay.push_back(as_mapped(i));
+    if (moved) changed.push_back(stay.back().bounds);  // where it lies
     order.push_back(i);
     reported.push_back(reported_[i]);
     placed.push_back(poses_[i]);

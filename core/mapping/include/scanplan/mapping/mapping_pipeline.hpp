@@ -28,11 +28,9 @@ class MappingPipeline {
  public:
   explicit MappingPipeline(PipelineConfig config = {});
 
-  // `cloud` in the scan's own frame (origin on the ground under the scanner), in measuring
-  // order; `pose` places it in the map.
-  InsertStats add_scan(const PointCloud& cloud, const Pose& pose);
-  // The same with the scan's points already in the map frame, as placed at `placed_at`; the map
-  // holds them moved to `pose`.
+  // A scan in measuring order, its points in the map frame as placed at `placed_at` (a scan in
+  // its own frame, origin on the ground under the scanner: `placed_at` the origin); the map holds
+  // it at `pose`.
   InsertStats add_placed_scan(const PointCloud& in_map, const Pose& placed_at, const Pose& pose);
 
   struct PlacedScan {
