@@ -260,7 +260,8 @@ void run_simulate(const SimulateArgs& a) {
   if (!csv) throw std::runtime_error("cannot write " + (out / "coverage.csv").string());
   csv << "scan,x,y,detected_m2,completed_m2,coverage_pct,path_m,plan_ms,placed_error_m,"
          "placed_error_deg,matched_error_m,matched_error_deg\n";
-  const auto on_step = [&](const LoopStep& s, const MappingPipeline& pipeline) {
+  const auto on_step = [&](const LoopStep& s, const MissionPipeline& mission) {
+    const MappingPipeline& pipeline = mission.mapping();
     char row[256];
     std::snprintf(row, sizeof row, "%d,%.3f,%.3f,%.1f,%.1f,%.2f,%.2f,%.1f,%.4f,%.3f,%.4f,%.3f\n",
                   s.scan, s.true_pose.x, s.true_pose.y, s.detected_m2, s.completed_m2,

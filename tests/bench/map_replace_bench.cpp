@@ -84,7 +84,7 @@ std::size_t cells_differing(const MlsMap& a, const MlsMap& b) {
       const SurfacePatch& p = x.patches[k];
       const SurfacePatch& q = y->patches[k];
       if (p.min_z != q.min_z || p.max_z != q.max_z || p.mean_z != q.mean_z || p.m2 != q.m2 ||
-          p.count != q.count) {
+          p.count != q.count || p.seen_from != q.seen_from) {
         return false;
       }
     }

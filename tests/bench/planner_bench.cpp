@@ -295,7 +295,7 @@ int coverage_study(int seeds, const std::string& policies, const std::string& wo
                               {"coverage_pct", nlohmann::json::array()},
                               {"path_m", nlohmann::json::array()}};
       const LoopResult r =
-          run_closed_loop(world, cfg, [&](const LoopStep& s, const MappingPipeline&) {
+          run_closed_loop(world, cfg, [&](const LoopStep& s, const MissionPipeline&) {
             if (s.scan == 13) d13 = s.detected_m2;
             ms += s.plan_ms;
             curve["detected_m2"].push_back(s.detected_m2);

@@ -39,7 +39,8 @@ inline ::testing::AssertionResult same_map(const MlsMap& a, const MlsMap& b,
       const auto near = [&](float u, float v) { return std::abs(u - v) <= tolerance_m; };
       const float m2_tolerance = tolerance_m * static_cast<float>(p.count);
       if (!near(p.min_z, q.min_z) || !near(p.max_z, q.max_z) || !near(p.mean_z, q.mean_z) ||
-          std::abs(p.m2 - q.m2) > m2_tolerance || p.count != q.count) {
+          std::abs(p.m2 - q.m2) > m2_tolerance || p.count != q.count ||
+          p.seen_from != q.seen_from) {
         first_difference = at + ", surface " + std::to_string(k) + " differs";
         return;
       }

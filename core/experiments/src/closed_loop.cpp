@@ -14,9 +14,6 @@
 namespace scanplan {
 namespace {
 
-// The simulated robot's name in the scan graph.
-const std::string kTrack = "robot";
-
 // The coverage denominator: MLS cells of the target region holding ground the robot could
 // reach from its start in the true world (DESIGN.md: coverage_pct), as cells of the map, whose
 // frame (the first scan's placed pose) is `map_from_world` from the world's.
@@ -74,13 +71,13 @@ std::optional<std::size_t> drive_to_best(const WorldTraversability& trav,
 // there (Placement).
 void place(MissionPipeline& mission, const PointCloud& cloud, LoopStep& step,
            const std::optional<Eigen::Vector3d>& goal, double driven_m) {
-  step.prior_pose = mission.prior(step.reported_pose, kTrack);
+  step.prior_pose = mission.prior(step.reported_pose, kLoopTrack);
   step.matched_pose = step.prior_pose;
   Placement where{step.reported_pose, step.prior_pose, false};
-  where.track = kTrack;
+  where.track = kLoopTrack;
   where.goal = goal;
   where.driven_m = driven_m;
-  if (const auto m = mission.place(cloud, step.reported_pose, kTrack, driven_m)) {
+  if (const auto m = mission.place(cloud, step.reported_pose, kLoopTrack, driven_m)) {
     step.match = m->result;
     step.match_applied = m->applied;
     step.matched_pose = m->placed;
@@ -226,7 +223,7 @@ PoseError placed_error(const Pose& first_placed, const Pose& first_true, const P
 
 LoopResult run_closed_loop(
     const World& world, const ClosedLoopConfig& config,
-    const std::function<void(const LoopStep&, const MappingPipeline&)>& on_step) {
+    const std::function<void(const LoopStep&, const MissionPipeline&)>& on_step) {
   const RayCaster caster(world);
   const WorldTraversability trav(world, caster);
   Pose truth = trav.standing_pose(world.start.x, world.start.y, world.start.z, world.start.yaw);
@@ -282,7 +279,7 @@ LoopResult run_closed_loop(
                                                                   : pipeline.scan_poses().back();
       const Plan plan = mission.plan_from(
           {at.x, at.y, at.z}, config.planner.seed * 1000003u + static_cast<std::uint64_t>(scan),
-          kTrack);
+          kLoopTrack);
       step.plan_ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       step.candidates = plan.ranked;
@@ -294,7 +291,7 @@ LoopResult run_closed_loop(
         goal_travel_m = plan.ranked[*step.chosen].travel_m;
       }
     }
-    if (on_step) on_step(step, pipeline);
+    if (on_step) on_step(step, mission);
     result.steps.push_back(std::move(step));
     const LoopStep& done = result.steps.back();
     if (done.coverage_pct >= config.stop_at_coverage_pct) {

@@ -36,6 +36,7 @@ void SurfacePatch::merge(const SurfacePatch& o) {
   count += o.count;
   min_z = std::min(min_z, o.min_z);
   max_z = std::max(max_z, o.max_z);
+  seen_from |= o.seen_from;
 }
 
 MlsMap::MlsMap(MlsConfig config)
@@ -102,16 +103,26 @@ void MlsMap::enter_tile(std::int32_t tx, std::int32_t ty, Cursor& at) {
     c->size = 0;
     c->interpolated = false;
   }
-  add_to_cell(*c, p.z());
+  const ViewSectors seen_from =
+      at.scanner_known
+          ? static_cast<ViewSectors>(1u << view_sector(at.scanner_x - p.x(), at.scanner_y - p.y()))
+          : 0;
+  add_to_cell(*c, p.z(), seen_from);
 }
 
 InsertStats MlsMap::insert(const PointCloud& cloud) {
   return insert(cloud.points);
 }
 
-InsertStats MlsMap::insert(const std::vector<Eigen::Vector3f>& points) {
+InsertStats MlsMap::insert(const std::vector<Eigen::Vector3f>& points,
+                           std::optional<Eigen::Vector2d> scanner) {
   InsertStats stats;
   Cursor at;
+  if (scanner) {
+    at.scanner_known = true;
+    at.scanner_x = static_cast<float>(scanner->x());
+    at.scanner_y = static_cast<float>(scanner->y());
+  }
   const float limit = static_cast<float>(config_.max_coordinate_m);
   for (const Eigen::Vector3f& p : points) {
     // NaN fails every comparison, so this refuses NaN, ±inf and the absurdly far alike.
@@ -159,6 +170,10 @@ InsertStats MlsMap::insert_fans(const PointCloud& scan, const Eigen::Isometry3d*
   InsertStats stats;
   Cursor at;
   at.only = only;
+  const Eigen::Vector3d scanner = map_from_scan * sensor_in_scan;
+  at.scanner_known = true;
+  at.scanner_x = static_cast<float>(scanner.x());
+  at.scanner_y = static_cast<float>(scanner.y());
   const Eigen::Isometry3f T = map_from_scan.cast<float>();
   const Eigen::Isometry3f lag =
       placed_at ? Eigen::Isometry3f((map_from_scan * placed_at->inverse()).cast<float>())
@@ -248,7 +263,7 @@ void MlsMap::fill_between(const Eigen::Vector3f& a, const Eigen::Vector3f& b, Cu
     MlsCell* filled = cell_at(c, at);
     if (!filled || !filled->empty()) continue;
     occupy(c);
-    add_to_cell(*filled, p.z());
+    add_to_cell(*filled, p.z(), 0);
     filled->interpolated = true;
   }
 }
@@ -311,7 +326,7 @@ void MlsMap::recompute_extent() {
   });
 }
 
-void MlsMap::add_to_cell(MlsCell& cell, float z) {
+void MlsMap::add_to_cell(MlsCell& cell, float z, ViewSectors seen_from) {
   auto& ps = cell.patches;
   int n = cell.size;
   const auto erase = [&](int k) {
@@ -321,6 +336,7 @@ void MlsMap::add_to_cell(MlsCell& cell, float z) {
   for (int k = 0; k < n; ++k) {
     if (z < ps[k].min_z - gap_ || z > ps[k].max_z + gap_) continue;
     ps[k].add(z);
+    ps[k].seen_from |= seen_from;
     // Growing this patch may have closed the gap to a neighbour: the two are one surface now.
     if (k + 1 < n && ps[k + 1].min_z - ps[k].max_z <= gap_) {
       ps[k].merge(ps[k + 1]);
@@ -341,11 +357,13 @@ void MlsMap::add_to_cell(MlsCell& cell, float z) {
     const int k =
         (above < 0 || (below >= 0 && z - ps[below].max_z < ps[above].min_z - z)) ? below : above;
     ps[k].add(z);
+    ps[k].seen_from |= seen_from;
     return;
   }
   for (int i = n; i > at; --i) ps[i] = ps[i - 1];
   ps[at] = SurfacePatch{};
   ps[at].add(z);
+  ps[at].seen_from = seen_from;
   cell.size = static_cast<std::uint8_t>(n + 1);
 }
 

@@ -2,7 +2,10 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <optional>
+#include <vector>
 
 #include "digest.hpp"
 #include "scanplan/geometry/pose.hpp"
@@ -19,6 +22,11 @@ RegistrabilityField::RegistrabilityField(const MlsMap& anchored, CellIndex origi
   // The share of a cell within inlier_distance_m of one point in it.
   const double near_area =
       M_PI * config.inlier_distance_m * config.inlier_distance_m / (cell_m_ * cell_m_);
+  const auto cell_offset = [cols](int i, int j) {
+    return static_cast<std::size_t>(j) * static_cast<std::size_t>(cols) +
+           static_cast<std::size_t>(i);
+  };
+  std::vector<ViewSectors> seen(cells_.size(), 0);  // per wall cell: its walls' seen_from
   for (int j = 0; j < rows; ++j) {
     for (int i = 0; i < cols; ++i) {
       const MlsCell* c = anchored.cell({origin.x + i, origin.y + j});
@@ -30,7 +38,10 @@ RegistrabilityField::RegistrabilityField(const MlsMap& anchored, CellIndex origi
       double points = 0;
       for (const SurfacePatch& p : *c) {
         points += p.count;
-        if (p.extent() >= config.wall_min_extent_m) out.wall = 1;
+        if (p.extent() >= config.wall_min_extent_m) {
+          out.wall = 1;
+          seen[cell_offset(i, j)] |= p.seen_from;
+        }
       }
       // In sixteenths: a cell a new scan adds a few points to keeps its odds once it holds a
       // dozen, so the evaluations that read it stay reusable between plans (GainMemo).
@@ -63,19 +74,74 @@ RegistrabilityField::RegistrabilityField(const MlsMap& anchored, CellIndex origi
         }
       }
       Eigen::Matrix2d t = 0.5 * Eigen::Matrix2d::Identity();
+      std::optional<Eigen::Vector2d> normal;
       if (n >= 3) {
         const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(spread);
         // A line of walls: its spread along is several times that across.
         if (eig.eigenvalues()[1] > 4 * eig.eigenvalues()[0]) {
-          const Eigen::Vector2d normal = eig.eigenvectors().col(0);
-          t = normal * normal.transpose();
+          normal = eig.eigenvectors().col(0);
+          t = *normal * normal->transpose();
         }
       }
+      if (config.sided_walls) w.visible_from = visible_from(seen[cell_offset(i, j)], normal);
       w.t_xx = static_cast<float>(t(0, 0));
       w.t_xy = static_cast<float>(t(0, 1));
       w.t_yy = static_cast<float>(t(1, 1));
     }
   }
+}
+
+namespace {
+
+// The unit direction through the middle of view sector s.
+const Eigen::Vector2d& sector_direction(int s) {
+  static const std::array<Eigen::Vector2d, kViewSectors> directions = [] {
+    std::array<Eigen::Vector2d, kViewSectors> d;
+    for (int k = 0; k < kViewSectors; ++k) {
+      const double a = (k + 0.5) * 2 * M_PI / kViewSectors;
+      d[static_cast<std::size_t>(k)] = {std::cos(a), std::sin(a)};
+    }
+    return d;
+  }();
+  return directions[static_cast<std::size_t>(s)];
+}
+
+}  // namespace
+
+ViewSectors RegistrabilityField::visible_from(ViewSectors seen,
+                                              const std::optional<Eigen::Vector2d>& normal) {
+  if (seen == 0) return 0xFFFF;  // measured without its scanner: seen from anywhere
+  if (!normal) {
+    // A corner or a post: met from within a right angle of where it was seen, the face the
+    // scanner met turned towards it.
+    ViewSectors visible = 0;
+    for (int c = 0; c < kViewSectors; ++c) {
+      for (int s = 0; s < kViewSectors; ++s) {
+        if ((seen >> s & 1) && sector_direction(c).dot(sector_direction(s)) > -1e-9) {
+          visible |= static_cast<ViewSectors>(1u << c);
+        }
+      }
+    }
+    return visible;
+  }
+  // A straight wall: from the side its scanners stood on. A sector the wall's line passes
+  // through (its middle within half a sector of the line) lies on both sides.
+  const double straddles = std::sin(M_PI / kViewSectors);
+  bool sides[2] = {false, false};  // [0]: along the normal, [1]: against it
+  for (int s = 0; s < kViewSectors; ++s) {
+    const double across = normal->dot(sector_direction(s));
+    if ((seen >> s & 1) && std::abs(across) >= straddles) sides[across < 0] = true;
+  }
+  // Seen only along the wall: which side is not known.
+  if (!sides[0] && !sides[1]) return 0xFFFF;
+  ViewSectors visible = 0;
+  for (int c = 0; c < kViewSectors; ++c) {
+    const double across = normal->dot(sector_direction(c));
+    if (std::abs(across) < straddles || sides[across < 0]) {
+      visible |= static_cast<ViewSectors>(1u << c);
+    }
+  }
+  return visible;
 }
 
 void RegistrabilityField::Forecast::add(std::uint32_t o, int di, int dj) {
@@ -90,6 +156,10 @@ void RegistrabilityField::Forecast::add(std::uint32_t o, int di, int dj) {
   mapped_ += w;
   on_map_ += w * c.odds;
   if (!c.wall) return;
+  // A face the map holds from the other side: this scan meets another face here, or none.
+  if (!(c.visible_from >> view_sector(static_cast<float>(-px), static_cast<float>(-py)) & 1)) {
+    return;
+  }
   // The wall fixes the pose along its normal n: a row (n, p⊥·n) of the x, y, yaw Jacobian,
   // summed over the normals T = Σ n nᵀ stands for.
   const double qx = -py, qy = px;  // p⊥
@@ -108,6 +178,7 @@ std::uint64_t RegistrabilityField::digest() const {
   using digest::mix;
   const RegistrabilityConfig& c = config_;
   std::uint64_t h = mix(std::uint64_t{0xF1E1D}, static_cast<std::uint64_t>(c.enabled));
+  h = mix(h, static_cast<std::uint64_t>(c.sided_walls));
   for (const double v : {c.min_overlap_share, c.min_pose_fixing, c.floor_share, c.near_range_m,
                          c.inlier_distance_m, cell_m_})
     h = mix(h, v);
@@ -118,7 +189,9 @@ std::uint64_t RegistrabilityField::cell_digest(std::size_t offset) const {
   using digest::mix;
   const Cell& c = cells_[offset];
   const std::uint64_t flags = c.mapped | (std::uint64_t{c.wall} << 8);
-  return mix(mix(mix(mix(mix(std::uint64_t{0xCE11}, flags), c.odds), c.t_xx), c.t_xy), c.t_yy);
+  const std::uint64_t h =
+      mix(mix(mix(mix(mix(std::uint64_t{0xCE11}, flags), c.odds), c.t_xx), c.t_xy), c.t_yy);
+  return mix(h, std::uint64_t{c.visible_from});
 }
 
 Registrability RegistrabilityField::Forecast::result() const {

@@ -30,9 +30,9 @@ TEST(ClosedLoop, CoverageGrowsAndTheRobotDrivesToTheSuggestions) {
   ClosedLoopConfig c = quick(3);
   c.matching.reset();
   int seen = 0;
-  const LoopResult r = run_closed_loop(w, c, [&](const LoopStep& step, const MappingPipeline& m) {
+  const LoopResult r = run_closed_loop(w, c, [&](const LoopStep& step, const MissionPipeline& m) {
     ++seen;
-    EXPECT_EQ(m.scan_poses().size(), static_cast<std::size_t>(step.scan));
+    EXPECT_EQ(m.mapping().scan_poses().size(), static_cast<std::size_t>(step.scan));
   });
   ASSERT_EQ(r.steps.size(), 3u);
   EXPECT_EQ(seen, 3);

@@ -46,6 +46,41 @@ TEST(MlsMap, GapClosedByNewPointsMergesPatches) {
   EXPECT_NEAR(c->patches[0].variance(), 1.0f, 1e-6);
 }
 
+// Sector b holds the directions [22.5° b, 22.5° (b + 1)) from the x axis.
+TEST(MlsMap, ViewSectorsSplitTheCircleIntoSixteen) {
+  for (int b = 0; b < kViewSectors; ++b) {
+    for (const double within : {0.05, 0.5, 0.95}) {
+      const double a = (b + within) * 2 * M_PI / kViewSectors;
+      EXPECT_EQ(view_sector(static_cast<float>(std::cos(a)), static_cast<float>(std::sin(a))), b)
+          << "at " << a * 180 / M_PI << "°";
+    }
+  }
+}
+
+// A wall keeps the side it was measured from: the planner's forecast of a match counts it only
+// for a scan on that side (RegistrabilityField).
+TEST(MlsMap, SurfacesKeepTheDirectionsTheyWereMeasuredFrom) {
+  MlsMap map;
+  std::vector<Eigen::Vector3f> wall;
+  for (float z = 0; z <= 3; z += 0.25f) wall.emplace_back(10.5f, 0.5f, z);
+  map.insert(wall, Eigen::Vector2d(0.5, 0.0));  // from the west: the direction back is ~183°
+  const MlsCell* c = map.cell({10, 0});
+  ASSERT_NE(c, nullptr);
+  ASSERT_EQ(c->size, 1);
+  EXPECT_EQ(c->patches[0].seen_from, ViewSectors{1} << 8);
+  map.insert(wall, Eigen::Vector2d(10.0, 20.5));  // and from the north: ~91°
+  EXPECT_EQ(map.cell({10, 0})->patches[0].seen_from, (ViewSectors{1} << 8) | (ViewSectors{1} << 4));
+  // A scan carries its scanner with it; points without one are seen from anywhere.
+  PointCloud scan;
+  for (const Eigen::Vector3f& p : wall) scan.push_back(p - Eigen::Vector3f(30, 0.5f, 0), {1, 1, 1});
+  map.insert_scan(scan, Eigen::Isometry3d(Eigen::Translation3d(30, 0.5, 0)),
+                  Eigen::Vector3d(0, 0, 1));  // from the east: 0°
+  EXPECT_EQ(map.cell({10, 0})->patches[0].seen_from,
+            (ViewSectors{1} << 8) | (ViewSectors{1} << 4) | ViewSectors{1});
+  map.insert(std::vector<Eigen::Vector3f>{{20.5f, 0.5f, 0}});
+  EXPECT_EQ(map.cell({20, 0})->patches[0].seen_from, 0);
+}
+
 TEST(MlsMap, GrowsInEveryDirectionIncludingNegativeCells) {
   MlsMap map;
   map.insert(std::vector<Eigen::Vector3f>{{-1000.5f, -0.1f, 0.0f}, {2000.2f, 5000.9f, 1.0f}});

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -16,15 +17,27 @@ using Segment = std::pair<Eigen::Vector2d, Eigen::Vector2d>;
 // Flat ground over [0, 60)² below `ground_max_x`, a point every `ground_step_m` (densely
 // enough for every new point to have one within the matcher's 0.3 m), and 3 m walls along the
 // segments.
-MlsMap yard_with(const std::vector<Segment>& walls, double ground_max_x = 60,
+// A wall and where the scanner that measured it stood (none: unknown).
+struct Wall {
+  Segment line;
+  std::optional<Eigen::Vector2d> seen_from;
+};
+
+// Flat ground over [0, 60)² below `ground_max_x`, a point every `ground_step_m` (densely
+// enough for every new point to have one within the matcher's 0.3 m), and 3 m walls.
+MlsMap yard_with(const std::vector<Wall>& walls, double ground_max_x = 60,
                  double ground_step_m = 0.1) {
-  std::vector<Eigen::Vector3f> points;
+  std::vector<Eigen::Vector3f> ground;
   for (double x = ground_step_m / 2; x < ground_max_x; x += ground_step_m) {
     for (double y = ground_step_m / 2; y < 60; y += ground_step_m) {
-      points.emplace_back(static_cast<float>(x), static_cast<float>(y), 0.0f);
+      ground.emplace_back(static_cast<float>(x), static_cast<float>(y), 0.0f);
     }
   }
-  for (const auto& [a, b] : walls) {
+  MlsMap map;
+  map.insert(ground);
+  for (const auto& [line, seen_from] : walls) {
+    const auto& [a, b] = line;
+    std::vector<Eigen::Vector3f> points;
     const int steps = static_cast<int>((b - a).norm() / 0.25);
     for (int k = 0; k <= steps; ++k) {
       const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(k) / steps);
@@ -33,10 +46,16 @@ MlsMap yard_with(const std::vector<Segment>& walls, double ground_max_x = 60,
                             static_cast<float>(z));
       }
     }
+    map.insert(points, seen_from);
   }
-  MlsMap map;
-  map.insert(points);
   return map;
+}
+
+MlsMap yard_with(const std::vector<Segment>& walls, double ground_max_x = 60,
+                 double ground_step_m = 0.1) {
+  std::vector<Wall> unknown;
+  for (const Segment& w : walls) unknown.push_back({w, std::nullopt});
+  return yard_with(unknown, ground_max_x, ground_step_m);
 }
 
 constexpr int kSide = 60;
@@ -69,6 +88,39 @@ TEST(Registrability, ACorridorLeavesThePoseFreeAlongItCrossingWallsFixIt) {
   // Both scans see the map all round.
   EXPECT_NEAR(corridor.overlap_share, 1.0, 1e-9);
   EXPECT_NEAR(crossing.overlap_share, 1.0, 1e-9);
+}
+
+// A building's far face, which the map holds from a scan beyond it, is not what a scan from
+// this side meets: the street stays a corridor. On the campus, a scan south of a building whose
+// east face alone was mapped slid 2.6 m along the one wall it shared with the map; the forecast
+// had counted the east face (and the corner cells next to the scanner) as fixing it.
+TEST(Registrability, AWallSeenFromTheOtherSideDoesNotFixTheScan) {
+  const Segment north = {{5, 20.5}, {55, 20.5}}, south = {{5, 40.5}, {55, 40.5}};
+  const Segment across = {{50.5, 21}, {50.5, 40}};
+  const Eigen::Vector2d here(30.5, 30.5), beyond(58.5, 30.5);
+  const RegistrabilityConfig defaults;
+  // Measured from beyond it (x 58.5): the scan at x 30.5 would meet the building's west face.
+  const Registrability far_face =
+      forecast_at_centre(yard_with({{north, here}, {south, here}, {across, beyond}}));
+  // (What is left: the street's cells at the junction, which count as corners.)
+  EXPECT_LT(far_face.pose_fixing, 0.25 * defaults.min_pose_fixing);
+  EXPECT_LT(far_face.factor, 0.1);
+  // Measured from this side: it fixes x.
+  const Registrability near_face =
+      forecast_at_centre(yard_with({{north, here}, {south, here}, {across, here}}));
+  EXPECT_GT(near_face.pose_fixing, defaults.min_pose_fixing);
+  EXPECT_EQ(near_face.factor, 1.0);
+  // Where it was measured from is not known: counted.
+  EXPECT_NEAR(forecast_at_centre(yard_with({north, south, across})).pose_fixing,
+              near_face.pose_fixing, 1e-9);
+  // A post measured from beyond it (no one direction: every direction fixed alike) is met
+  // from within a right angle of where it was seen.
+  const Segment post = {{50.5, 30}, {50.5, 31}};
+  const Registrability post_behind =
+      forecast_at_centre(yard_with({{north, here}, {south, here}, {post, beyond}}));
+  const Registrability post_in_front =
+      forecast_at_centre(yard_with({{north, here}, {south, here}, {post, here}}));
+  EXPECT_LT(post_behind.pose_fixing, 0.1 * post_in_front.pose_fixing);
 }
 
 TEST(Registrability, TheOverlapIsTheShareOfTheScanOnTheAnchoredMap) {

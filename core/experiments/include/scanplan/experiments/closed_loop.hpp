@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "scanplan/mission/mission_pipeline.hpp"
@@ -113,12 +114,16 @@ struct LoopResult {
   std::string stopped_because;
 };
 
+// The simulated robot's name in the scan graph (its track).
+inline const std::string kLoopTrack = "robot";
+
 // The paper's procedure (§3: scan, map, movable region, plan, move, repeat) on a simulated
 // world: scans at the true pose, placed in the map at the reported one; the robot drives to
 // the best-ranked candidate it can really reach (an operator approving the top suggestion).
-// `on_step` sees each step with the map as it stands after that scan.
+// `on_step` sees each step with the mission (its map, graph and matcher) as it stands after
+// that scan.
 LoopResult run_closed_loop(
     const World& world, const ClosedLoopConfig& config,
-    const std::function<void(const LoopStep&, const MappingPipeline&)>& on_step = {});
+    const std::function<void(const LoopStep&, const MissionPipeline&)>& on_step = {});
 
 }  // namespace scanplan

@@ -32,12 +32,30 @@ struct MlsConfig {
   double fill_max_slope = 0.25;
 };
 
+// The x-y directions a surface was measured from, in 16 sectors of 22.5° (bit b: the direction
+// from a point to the scanner that measured it lay within [22.5° b, 22.5° (b + 1)) of the x
+// axis). A wall is a face seen from one side: a scan from behind it meets another face, or
+// nothing, of the same cell (RegistrabilityField).
+using ViewSectors = std::uint16_t;
+inline constexpr int kViewSectors = 16;
+// The sector of direction (dx, dy); comparisons only, as it runs for every point inserted.
+inline int view_sector(float dx, float dy) {
+  constexpr float kTan22 = 0.41421356f, kTan67 = 2.41421356f;  // tan 22.5°, tan 67.5°
+  const float ax = dx < 0 ? -dx : dx, ay = dy < 0 ? -dy : dy;
+  // The sector within the quadrant, from the x axis.
+  const int s = ay < kTan22 * ax ? 0 : ay < ax ? 1 : ay < kTan67 * ax ? 2 : 3;
+  if (dy >= 0) return dx >= 0 ? s : 7 - s;
+  return dx < 0 ? 8 + s : 15 - s;
+}
+
 // One surface in a cell: the heights of the points that fell on it.
 struct SurfacePatch {
   float min_z = 0, max_z = 0;
   float mean_z = 0;
   float m2 = 0;  // sum of squared deviations from the mean (Welford)
   std::uint32_t count = 0;
+  // Where its points were measured from (none for points inserted without their scanner).
+  ViewSectors seen_from = 0;
 
   float variance() const { return count > 1 ? m2 / static_cast<float>(count - 1) : 0.0f; }
   float extent() const { return max_z - min_z; }  // vertical depth: walls are deep, floors thin
@@ -102,9 +120,11 @@ class MlsMap {
 
   explicit MlsMap(MlsConfig config = {});
 
-  // Points already in the map frame (after matching). Non-finite points are refused.
+  // Points already in the map frame (after matching). Non-finite points are refused. With
+  // `scanner`, the x-y position they were measured from (SurfacePatch::seen_from).
   InsertStats insert(const PointCloud& cloud);
-  InsertStats insert(const std::vector<Eigen::Vector3f>& points);
+  InsertStats insert(const std::vector<Eigen::Vector3f>& points,
+                     std::optional<Eigen::Vector2d> scanner = std::nullopt);
   // A whole scan in its sensor's own frame, in the order the scanner measured it (fan by fan),
   // placed by `map_from_scan`; fills the ground between neighbouring returns of a fan (see
   // MlsConfig::fill_between_beams). `sensor_in_scan` is the laser's centre in the scan frame.
@@ -152,6 +172,9 @@ class MlsMap {
     Tile* tile = nullptr;  // null: none yet, or outside `only`
     std::uint64_t key = 0;
     bool valid = false;
+    // The scanner's x-y position in the map frame, when known.
+    bool scanner_known = false;
+    float scanner_x = 0, scanner_y = 0;
   };
   static std::uint64_t tile_key(std::int32_t tx, std::int32_t ty);
   // `placed_at`: where the points were placed in the map frame; nothing: in the scan's frame.
@@ -160,7 +183,7 @@ class MlsMap {
                           const Eigen::Isometry3d& map_from_scan,
                           const Eigen::Vector3d& sensor_in_scan, const Tiles* only);
   void insert_point(const Eigen::Vector3f& p, Cursor& at);
-  void add_to_cell(MlsCell& cell, float z);
+  void add_to_cell(MlsCell& cell, float z, ViewSectors seen_from);
   // The cell, perhaps empty, its tile made if need be; null outside the cursor's `only`.
   MlsCell* cell_at(CellIndex c, Cursor& at);
   void enter_tile(std::int32_t tx, std::int32_t ty, Cursor& at);

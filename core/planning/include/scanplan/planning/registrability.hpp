@@ -1,6 +1,8 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "scanplan/geometry/cell_grid.hpp"
@@ -42,9 +44,17 @@ struct RegistrabilityConfig {
   double wall_min_extent_m = 0.5;
   // A wall's direction is that of the walls within this many cells of it.
   int wall_radius_cells = 2;
+  // A wall counts only for a scan on the side its scanners stood on (SurfacePatch::seen_from):
+  // from the other side the scan meets another face, or none (on the campus, a building's far
+  // face made a street look registrable). Off: every wall counts from anywhere (the forecast
+  // before 2026-12-07, registrability_bench's baseline).
+  bool sided_walls = true;
   // Cells nearer the scanner than this are weighted as if this far: a scan's point density
   // falls with the square of the range, and a wall next to the scanner is not infinitely
-  // many points.
+  // many points. (The matcher thins both clouds to 0.25 m voxels, which the scanner's 0.5°
+  // steps fill out to 28.6 m: weighted alike to there, the forecast ranked right matches above
+  // failed ones better in registrability_bench, but with the threshold moved to keep as many
+  // right ones, the loop placed fewer scans; docs/benchmarks.md, 2026-12-07.)
   double near_range_m = 3.0;
   // With odometry that drifts (DriveDrift), a candidate a long drive away is reached with a
   // pose 3σ of which may lie beyond the scan matcher's own search (PoseSearchConfig: ±6 m,
@@ -121,9 +131,16 @@ class RegistrabilityField {
     // n nᵀ of the wall's normal (in the x-y plane); I/2 where the walls around have no one
     // direction (a post, a corner); zero where there is no wall.
     float t_xx = 0, t_xy = 0, t_yy = 0;
+    // The directions (MlsMap's view sectors, from the cell) from which a scan meets the face
+    // the map holds here: the side of the wall its scanners stood on (all, where unknown).
+    ViewSectors visible_from = 0xFFFF;
     float odds = 0;  // that a new point here has a measured map point within inlier_distance_m
     std::uint8_t mapped = 0, wall = 0;
   };
+  // The view sectors a wall cell is met from: those on the side of the wall (its `normal`, for
+  // a straight one) its scanners stood on, `seen`.
+  static ViewSectors visible_from(ViewSectors seen, const std::optional<Eigen::Vector2d>& normal);
+
   RegistrabilityConfig config_;
   double cell_m_;
   int cols_, rows_;
