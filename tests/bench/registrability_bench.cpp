@@ -64,8 +64,12 @@ double auc(const std::vector<Sample>& samples, double (*score)(const Registrabil
   return pairs > 0 ? above / pairs : 0.0;
 }
 
-double fixing(const Registrability& r) { return r.pose_fixing; }
-double factor(const Registrability& r) { return r.factor; }
+double fixing(const Registrability& r) {
+  return r.pose_fixing;
+}
+double factor(const Registrability& r) {
+  return r.factor;
+}
 
 }  // namespace
 
@@ -116,10 +120,10 @@ int main(int argc, char** argv) {
         const double driven = reach.distance_m[*cell];
         const Pose truth =
             trav.standing_pose(goal.x(), goal.y(), reach.z[*cell], step.true_pose.yaw);
-        const PointCloud cloud = simulate_scan(
-            caster, world.scanner, truth,
-            static_cast<std::uint64_t>(seed) * 7919u + 1000u * static_cast<std::uint64_t>(step.scan) +
-                k);
+        const PointCloud cloud =
+            simulate_scan(caster, world.scanner, truth,
+                          static_cast<std::uint64_t>(seed) * 7919u +
+                              1000u * static_cast<std::uint64_t>(step.scan) + k);
         // The drive there as the robot's odometry reports it (PoseNoise's drift model).
         RelativePose move = relative_pose(step.true_pose, truth);
         std::normal_distribution<double> unit(0.0, 1.0);
@@ -181,8 +185,8 @@ int main(int argc, char** argv) {
       fn += !ok && s.right;
     }
     out["variants"][kVariants[v].name] = {
-        {"forecast_registrable_right", tp},    {"forecast_registrable_failed", fp},
-        {"forecast_unregistrable_failed", tn}, {"forecast_unregistrable_right", fn},
+        {"forecast_registrable_right", tp},           {"forecast_registrable_failed", fp},
+        {"forecast_unregistrable_failed", tn},        {"forecast_unregistrable_right", fn},
         {"auc_pose_fixing", auc(samples, fixing, v)}, {"auc_factor", auc(samples, factor, v)}};
   }
   if (!samples_csv.empty()) {
