@@ -20,12 +20,21 @@ void MappingPipeline::replace_scans(const std::vector<PlacedScan>& scans,
   for (const PlacedScan& s : scans) poses_.push_back(s.pose);
   if (!tiles.empty()) {
     map_.clear(tiles);
-    for (const PlacedScan& s : scans) {
-      if (tiles.reaches(s.bounds)) {
-        map_.insert_placed_scan(*s.in_map, s.placed_at.isometry(), s.pose.isometry(), sensor(),
-                                &tiles);
+    // West and east of the changed tiles at once, each in a map of its own (a cell's state
+    // follows from the points that reached it, in their order, whoever inserts them).
+    const auto [west, east] = tiles.halves();
+    const MlsMap::Tiles* part_tiles[2] = {&west, &east};
+    MlsMap parts[2] = {MlsMap(config_.mls), MlsMap(config_.mls)};
+#pragma omp parallel for num_threads(config_.threads > 0 ? config_.threads : 2) schedule(static, 1)
+    for (int k = 0; k < 2; ++k) {
+      for (const PlacedScan& s : scans) {
+        if (part_tiles[k]->reaches(s.bounds)) {
+          parts[k].insert_placed_scan(*s.in_map, s.placed_at.isometry(), s.pose.isometry(),
+                                      sensor(), part_tiles[k]);
+        }
       }
     }
+    for (MlsMap& part : parts) map_.adopt(std::move(part));
   }
   if (poses_.empty()) {
     regions_.reset();

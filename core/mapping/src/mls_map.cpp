@@ -299,6 +299,45 @@ bool MlsMap::Tiles::reaches(const Bounds3& box) const {
   });
 }
 
+std::pair<MlsMap::Tiles, MlsMap::Tiles> MlsMap::Tiles::halves() const {
+  std::pair<Tiles, Tiles> out{Tiles(inv_cell_, max_coordinate_m_),
+                              Tiles(inv_cell_, max_coordinate_m_)};
+  if (rects_.empty()) return out;
+  // The column where the rectangles' tiles (overlaps counted twice: near enough) reach half.
+  std::int64_t total = 0;
+  std::int32_t lo = rects_.front().x0, hi = rects_.front().x1;
+  for (const Rect& r : rects_) {
+    total += static_cast<std::int64_t>(r.x1 - r.x0 + 1) * (r.y1 - r.y0 + 1);
+    lo = std::min(lo, r.x0);
+    hi = std::max(hi, r.x1);
+  }
+  std::int32_t split = hi + 1;
+  std::int64_t west = 0;
+  for (std::int32_t x = lo; x <= hi; ++x) {
+    if (2 * west >= total) {
+      split = x;
+      break;
+    }
+    for (const Rect& r : rects_) west += (x >= r.x0 && x <= r.x1) ? r.y1 - r.y0 + 1 : 0;
+  }
+  for (const Rect& r : rects_) {
+    if (r.x0 < split) out.first.rects_.push_back({r.x0, r.y0, std::min(r.x1, split - 1), r.y1});
+    if (r.x1 >= split) out.second.rects_.push_back({std::max(r.x0, split), r.y0, r.x1, r.y1});
+  }
+  return out;
+}
+
+void MlsMap::adopt(MlsMap&& part) {
+  if (part.config_.cell_m != config_.cell_m || part.gap_ != gap_) {
+    throw std::invalid_argument("MlsMap::adopt: the part has another cell size or robot height");
+  }
+  for (auto& [key, tile] : part.tiles_) tiles_[key] = std::move(tile);
+  occupied_ += part.occupied_;
+  part.tiles_.clear();
+  part.occupied_ = 0;
+  recompute_extent();
+}
+
 void MlsMap::clear(const Tiles& tiles) {
   for (auto it = tiles_.begin(); it != tiles_.end();) {
     const std::int32_t tx = static_cast<std::int32_t>(it->first >> 32);

@@ -231,6 +231,24 @@ TEST(MlsMap, ClearedTilesFilledAgainAreTheMapTheScansMakeFromScratch) {
     scratch.insert_placed_scan(s.in_map, s.at.isometry(), s.at.isometry(), sensor);
   EXPECT_TRUE(testing_support::same_map(map, scratch));
   EXPECT_TRUE(testing_support::same_map(scratch, map));
+
+  // The same tiles filled in two halves, each in a map of its own (as two threads do), and
+  // taken over: the same map again.
+  const auto [west, east] = changed.halves();
+  EXPECT_FALSE(west.empty());
+  EXPECT_FALSE(east.empty());
+  map.clear(changed);
+  for (const MlsMap::Tiles* half : {&west, &east}) {
+    MlsMap part;
+    for (const Placed& s : scans) {
+      if (half->reaches(bounds_of(s.in_map))) {
+        part.insert_placed_scan(s.in_map, s.at.isometry(), s.at.isometry(), sensor, half);
+      }
+    }
+    map.adopt(std::move(part));
+  }
+  EXPECT_TRUE(testing_support::same_map(map, scratch));
+  EXPECT_TRUE(testing_support::same_map(scratch, map));
 }
 
 // A scan kept in the map frame goes in as the same scan in its own frame does: the beams that

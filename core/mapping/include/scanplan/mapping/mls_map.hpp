@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -105,6 +106,10 @@ class MlsMap {
     bool reaches(const Bounds3& box) const;
     bool contains(std::int32_t tx, std::int32_t ty) const;
     bool empty() const { return rects_.empty(); }
+    // The tiles west and east of a column chosen so that the two hold about as many tiles:
+    // parts of the map to fill at once (MlsMap::adopt). The east half is empty when the tiles
+    // span one column.
+    std::pair<Tiles, Tiles> halves() const;
 
    private:
     friend class MlsMap;
@@ -146,6 +151,10 @@ class MlsMap {
   // made of an empty map, cell for cell: a cell's state follows from the points that reached it,
   // in their order.
   void clear(const Tiles& tiles);
+  // Takes over every tile of `part` (a map of the same configuration, filled restricted to
+  // tiles this map has cleared or never had): a map filled part by part, each part by another
+  // thread, as MappingPipeline::replace_scans does.
+  void adopt(MlsMap&& part);
 
   const MlsConfig& config() const { return config_; }
   double cell_m() const { return config_.cell_m; }
