@@ -3,9 +3,9 @@
 // the graph on); after each scan, at the best-ranked candidates the robot could drive to, a scan
 // is simulated, reported with the drift of the drive there, and matched to the map as it stands
 // (MissionPipeline::place, which changes nothing). Each candidate is forecast by every variant
-// on the same map: the baseline (every wall counts from anywhere: the forecast before
-// 2026-12-07), RegistrabilityConfig::sided_walls (the planner's), and the same with cells
-// weighted alike out to 28.6 m (near_range_m; tried and not kept). A candidate is forecast
+// on the same map: the baseline (every wall counts from anywhere, a wall's direction from the
+// cells within 2 of it: the forecast before 2026-12-07), RegistrabilityConfig::sided_walls
+// alone, and with wall_line_radius_cells too (the planner's). A candidate is forecast
 // registrable when the forecast keeps its whole score (factor 1); a match is right when applied
 // within 10 cm / 0.3° of the truth. Prints one JSON line: per variant the confusion counts and
 // how well pose_fixing and the score share rank right matches above failed ones (AUC). Usage:
@@ -34,10 +34,10 @@ using namespace scanplan;
 struct Variant {
   const char* name;
   bool sided_walls;
-  double near_range_m;
+  int wall_line_radius_cells;
 };
 constexpr Variant kVariants[] = {
-    {"baseline", false, 3.0}, {"sided_walls", true, 3.0}, {"sided_walls_near_28_6", true, 28.6}};
+    {"baseline", false, 0}, {"sided_walls", true, 0}, {"wall_lines", true, 6}};
 constexpr int kVariantCount = sizeof kVariants / sizeof kVariants[0];
 
 struct Sample {
@@ -150,7 +150,7 @@ int main(int argc, char** argv) {
         for (int v = 0; v < kVariantCount; ++v) {
           PlannerConfig planner = mission.planner_config();
           planner.registrability.sided_walls = kVariants[v].sided_walls;
-          planner.registrability.near_range_m = kVariants[v].near_range_m;
+          planner.registrability.wall_line_radius_cells = kVariants[v].wall_line_radius_cells;
           Candidate detail;
           evaluate(in, planner, c.position, &detail);
           if (detail.registrability) s.forecast[v] = *detail.registrability;

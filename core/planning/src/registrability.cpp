@@ -54,41 +54,67 @@ RegistrabilityField::RegistrabilityField(const MlsMap& anchored, CellIndex origi
   const int r = std::max(1, config.wall_radius_cells);
   for (int j = 0; j < rows; ++j) {
     for (int i = 0; i < cols; ++i) {
-      Cell& w = cells_[static_cast<std::size_t>(j) * static_cast<std::size_t>(cols) +
-                       static_cast<std::size_t>(i)];
+      Cell& w = cells_[cell_offset(i, j)];
       if (!w.wall) continue;
-      Eigen::Matrix2d spread = Eigen::Matrix2d::Zero();
-      int n = 0;
-      for (int dj = -r; dj <= r; ++dj) {
-        for (int di = -r; di <= r; ++di) {
-          const int x = i + di, y = j + dj;
-          if (x < 0 || y < 0 || x >= cols || y >= rows || di * di + dj * dj > r * r) continue;
-          if (!cells_[static_cast<std::size_t>(y) * static_cast<std::size_t>(cols) +
-                      static_cast<std::size_t>(x)]
-                   .wall) {
-            continue;
-          }
-          const Eigen::Vector2d d(di, dj);
-          spread += d * d.transpose();
-          ++n;
+      const WallLine near = wall_line(i, j, r);
+      std::optional<Eigen::Vector2d> normal = near.normal;
+      if (!normal && config.wall_line_radius_cells > r) {
+        normal = wall_line(i, j, config.wall_line_radius_cells, 1.0).normal;
+        // A lone cell: a wall met end-on, or a post in a row.
+        if (normal && near.cells < 3 && !seen_along(seen[cell_offset(i, j)], *normal)) {
+          normal.reset();
         }
       }
       Eigen::Matrix2d t = 0.5 * Eigen::Matrix2d::Identity();
-      std::optional<Eigen::Vector2d> normal;
-      if (n >= 3) {
-        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(spread);
-        // A line of walls: its spread along is several times that across.
-        if (eig.eigenvalues()[1] > 4 * eig.eigenvalues()[0]) {
-          normal = eig.eigenvectors().col(0);
-          t = *normal * normal->transpose();
-        }
-      }
+      if (normal) t = *normal * normal->transpose();
       if (config.sided_walls) w.visible_from = visible_from(seen[cell_offset(i, j)], normal);
       w.t_xx = static_cast<float>(t(0, 0));
       w.t_xy = static_cast<float>(t(0, 1));
       w.t_yy = static_cast<float>(t(1, 1));
     }
   }
+}
+
+RegistrabilityField::WallLine RegistrabilityField::wall_line(
+    int i, int j, int radius, std::optional<double> max_off_line) const {
+  WallLine line;
+  std::vector<Eigen::Vector2d> offsets;
+  Eigen::Matrix2d spread = Eigen::Matrix2d::Zero();
+  for (int dj = -radius; dj <= radius; ++dj) {
+    for (int di = -radius; di <= radius; ++di) {
+      const int x = i + di, y = j + dj;
+      if (x < 0 || y < 0 || x >= cols_ || y >= rows_ || di * di + dj * dj > radius * radius) {
+        continue;
+      }
+      if (!cells_[static_cast<std::size_t>(y) * static_cast<std::size_t>(cols_) +
+                  static_cast<std::size_t>(x)]
+               .wall) {
+        continue;
+      }
+      offsets.emplace_back(di, dj);
+      spread += offsets.back() * offsets.back().transpose();
+    }
+  }
+  line.cells = static_cast<int>(offsets.size());
+  if (line.cells < 3) return line;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(spread);
+  // The spread is taken about the cell itself, so its smaller eigenvalue per cell is how far off
+  // a line through the cell the others lie.
+  const Eigen::Vector2d& l = eig.eigenvalues();
+  if (l[1] <= 4 * l[0]) return line;
+  if (max_off_line) {
+    if (l[0] > *max_off_line * line.cells) return line;
+    // On both sides: the long face of a corner whose other face is short lies on one.
+    const Eigen::Vector2d along = eig.eigenvectors().col(1);
+    bool before = false, after = false;
+    for (const Eigen::Vector2d& d : offsets) {
+      before = before || d.dot(along) <= -1;
+      after = after || d.dot(along) >= 1;
+    }
+    if (!before || !after) return line;
+  }
+  line.normal = eig.eigenvectors().col(0);
+  return line;
 }
 
 namespace {
@@ -107,6 +133,17 @@ const Eigen::Vector2d& sector_direction(int s) {
 }
 
 }  // namespace
+
+bool RegistrabilityField::seen_along(ViewSectors seen, const Eigen::Vector2d& normal) {
+  if (seen == 0) return false;
+  for (int s = 0; s < kViewSectors; ++s) {
+    // Within 30° of the line (a sector's middle, so up to 41° for a scanner at its edge).
+    if ((seen >> s & 1) && std::abs(normal.dot(sector_direction(s))) > 0.5) {
+      return false;
+    }
+  }
+  return true;
+}
 
 ViewSectors RegistrabilityField::visible_from(ViewSectors seen,
                                               const std::optional<Eigen::Vector2d>& normal) {
@@ -179,6 +216,7 @@ std::uint64_t RegistrabilityField::digest() const {
   const RegistrabilityConfig& c = config_;
   std::uint64_t h = mix(std::uint64_t{0xF1E1D}, static_cast<std::uint64_t>(c.enabled));
   h = mix(h, static_cast<std::uint64_t>(c.sided_walls));
+  h = mix(h, static_cast<std::uint64_t>(c.wall_line_radius_cells));
   for (const double v : {c.min_overlap_share, c.min_pose_fixing, c.floor_share, c.near_range_m,
                          c.inlier_distance_m, cell_m_})
     h = mix(h, v);

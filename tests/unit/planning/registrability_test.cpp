@@ -123,6 +123,52 @@ TEST(Registrability, AWallSeenFromTheOtherSideDoesNotFixTheScan) {
   EXPECT_LT(post_behind.pose_fixing, 0.1 * post_in_front.pose_fixing);
 }
 
+// A wall met end-on from afar holds points only where the stage's azimuth steps cross it: a row
+// of single wall cells a few cells apart. Each alone looks like a post, which fixes every
+// direction; together they are one wall, which fixes the pose across itself only. Measured
+// whole, a wall a few degrees off the grid steps through its cells, and each step looked like
+// a corner. On the campus a building's 12°-turned face made the street before it look
+// registrable, and every scan planned there was refused as a corridor.
+TEST(Registrability, AWallTurnedOffTheGridOrMetEndOnIsAWall) {
+  const Segment street = {{5, 20.5}, {55, 20.5}};
+  const Eigen::Vector2d here(30.5, 30.5);
+  // Columns every 3 m along a line turned 12°, each within one cell.
+  const double slope = std::tan(12.0 * M_PI / 180);
+  std::vector<Segment> columns;
+  for (double x = 8.3; x < 52; x += 3) {
+    const double y = 35.3 + slope * (x - 8.3);
+    columns.push_back({{x, y}, {x + 0.3, y}});
+  }
+  const auto with_columns = [&](const Eigen::Vector2d& seen_from) {
+    std::vector<Wall> walls = {{street, here}};
+    for (const Segment& c : columns) walls.push_back({c, seen_from});
+    return walls;
+  };
+  // Seen from far along their line (the face's corner), and from across it.
+  const Eigen::Vector2d along(90, 35.3 + slope * (90 - 8.3)), across(30, 5);
+  RegistrabilityConfig posts;
+  posts.wall_line_radius_cells = 0;
+  const RegistrabilityConfig defaults;
+  const MlsMap end_on = yard_with(with_columns(along));
+  const Registrability as_posts = forecast_at_centre(end_on, posts);
+  const Registrability as_wall = forecast_at_centre(end_on, defaults);
+  // The street alone leaves x free; a wall turned 12° from it fixes x by sin² 12° of what it
+  // fixes across, posts as much as across.
+  EXPECT_LT(forecast_at_centre(yard_with(std::vector<Wall>{{street, here}})).pose_fixing, 1e-6);
+  EXPECT_LT(as_wall.pose_fixing, 0.2 * as_posts.pose_fixing);
+  EXPECT_LT(as_wall.factor, as_posts.factor);
+  // Measured whole from in front, the same face steps through its cells: it still fixes x
+  // only by sin² 12° of what it fixes across.
+  const Segment face = {columns.front().first, columns.back().first};
+  const MlsMap stepped = yard_with(std::vector<Wall>{{street, here}, {face, here}});
+  const double as_corners = forecast_at_centre(stepped, posts).pose_fixing;
+  EXPECT_GT(as_corners, defaults.min_pose_fixing);  // the L at every step a corner
+  EXPECT_LT(forecast_at_centre(stepped, defaults).pose_fixing, 0.2 * as_corners);
+  // Posts in a row met from the side are posts: a scan there meets each of them.
+  EXPECT_NEAR(forecast_at_centre(yard_with(with_columns(across)), defaults).pose_fixing,
+              forecast_at_centre(yard_with(with_columns(across)), posts).pose_fixing, 1e-12);
+}
+
 TEST(Registrability, TheOverlapIsTheShareOfTheScanOnTheAnchoredMap) {
   const std::vector<Segment> walls = {{{5, 20.5}, {55, 20.5}}, {{20.5, 5}, {20.5, 55}}};
   // Anchored ground only west of the scanner: half of what it sees, by symmetry.

@@ -44,6 +44,17 @@ struct RegistrabilityConfig {
   double wall_min_extent_m = 0.5;
   // A wall's direction is that of the walls within this many cells of it.
   int wall_radius_cells = 2;
+  // Where the walls within wall_radius_cells show no one direction, that of a straight line of
+  // wall cells through the cell and on both sides of it within this many cells. A wall a few
+  // degrees off the grid steps through its cells (an L of three cells looks like a corner), and
+  // one met end-on from afar holds points only where the stage's azimuth steps cross it, a row
+  // of single cells a few apart, each of which alone looks like a post; a corner or a post
+  // fixes every direction, a wall only across itself. A row of single cells counts as a wall
+  // only when its scanners stood along it (posts in a row met from the side are posts). On the
+  // campus a building turned 12° made the strip before its south face, seen end-on from its
+  // corner, look registrable, and every scan planned there was refused as a corridor
+  // (issue 15). 0: off (the forecast before 2026-12-07).
+  int wall_line_radius_cells = 6;
   // A wall counts only for a scan on the side its scanners stood on (SurfacePatch::seen_from):
   // from the other side the scan meets another face, or none (on the campus, a building's far
   // face made a street look registrable). Off: every wall counts from anywhere (the forecast
@@ -137,6 +148,17 @@ class RegistrabilityField {
     float odds = 0;  // that a new point here has a measured map point within inlier_distance_m
     std::uint8_t mapped = 0, wall = 0;
   };
+  // The wall cells within `radius` cells of cell (i, j), it included, and the line they lie
+  // on: its normal, where they spread along it several times more than across and, with
+  // `max_off_line` (squared cells), lie that near a line through the cell on average and on
+  // both sides of it.
+  struct WallLine {
+    int cells = 0;
+    std::optional<Eigen::Vector2d> normal;
+  };
+  WallLine wall_line(int i, int j, int radius, std::optional<double> max_off_line = {}) const;
+  // Whether a scanner in every sector of `seen` stood nearly along a line with `normal`.
+  static bool seen_along(ViewSectors seen, const Eigen::Vector2d& normal);
   // The view sectors a wall cell is met from: those on the side of the wall (its `normal`, for
   // a straight one) its scanners stood on, `seen`.
   static ViewSectors visible_from(ViewSectors seen, const std::optional<Eigen::Vector2d>& normal);
