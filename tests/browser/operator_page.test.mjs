@@ -114,6 +114,8 @@ test('operator page: map, candidates, approval, growth by WebSocket chunk, recon
     assert.match(await page.locator('#goal-where').innerText(), /\(-9\.\d, -6\.\d\)/);
     await page.click('#goal-propose');
     await waitForData(page, 'the custom candidate', () => !!document.querySelector('#cand-list .cand-row .rank.custom'));
+    // The list shows the new row as soon as the plan comes; the detail follows the selection.
+    await waitForData(page, 'the custom candidate selected', () => /custom point/.test(document.getElementById('cand-detail').textContent));
     assert.match(await page.locator('#cand-detail').innerText(), /custom point/);
     assert.ok(await page.locator('#goal-bar').isHidden(), 'the proposed point is taken over by the candidate');
     t.diagnostic(`shot: ${await screenshot(page, 'custom_goal.png')}`);

@@ -174,7 +174,7 @@ bool ScanGraph::odometry_agrees(std::size_t a, const Pose& a_placed, std::size_t
                                 const Pose& b_placed) const {
   const RelativePose move = relative_pose(reported_[a], reported_[b]);
   const Pose predicted = compose(a_placed, move, b_placed.roll, b_placed.pitch);
-  const MoveUncertainty u = odometry_uncertainty(move, previous_[b] == a ? driven_[b] : 0.0);
+  const MoveUncertainty u = odometry_uncertainty(move, driven_between(a, b));
   const double off_m = std::hypot(predicted.x - b_placed.x, predicted.y - b_placed.y);
   const double off_deg = std::abs(rad2deg(std::remainder(predicted.yaw - b_placed.yaw, 2 * M_PI)));
   // Never looser than a few metres: a look-alike lies a building's depth off (16 m on the
@@ -186,6 +186,31 @@ bool ScanGraph::odometry_agrees(std::size_t a, const Pose& a_placed, std::size_t
          off_deg <= std::clamp(3 * u.yaw_deg, 1.0, 10.0);
 }
 
+// The robot's latest scan before `k` whose map match waits for confirmation (pending_map_),
+// when only scans no match placed lie between the two (at most kMaxSkipped), else kNoNode: the
+// odometry over those drives still relates them. On the campus loop a correct far match was
+// lost when the robot's next scan stood in a corridor and was refused, and the scan stayed out
+// of the map, 3 m off.
+std::size_t ScanGraph::waiting_before(std::size_t k) const {
+  std::size_t p = previous_[k];
+  for (std::size_t skipped = 0; p != kNoNode; ++skipped, p = previous_[p]) {
+    if (pending_map_[p]) return p;
+    if (anchored_[p] || skipped == kMaxSkipped) break;
+  }
+  return kNoNode;
+}
+
+// The path the robot drove from scan `a` to its later scan `b` (Placement::driven_m summed
+// over the drives between), or 0 where a drive's path is unknown or `b` does not follow `a`.
+double ScanGraph::driven_between(std::size_t a, std::size_t b) const {
+  double sum = 0;
+  for (std::size_t n = b; n != a; n = previous_[n]) {
+    if (n == kNoNode || n < a || !(driven_[n] > 0)) return 0;
+    sum += driven_[n];
+  }
+  return sum;
+}
+
 // A map match that corrected the pose further than the sensors usually err (the search reached
 // farther because the robot drove far since its last anchored scan) is believed only when the
 // robot's previous scan, also corrected that far by its own map match, lies where the odometry
@@ -194,8 +219,9 @@ bool ScanGraph::odometry_agrees(std::size_t a, const Pose& a_placed, std::size_t
 void ScanGraph::confirm_by_odometry(std::size_t k) {
   // Two far corrections, each its own map match, agreeing: both are believed. The robot's
   // anchored scan before a waiting one says nothing (matching started from it and the
-  // odometry); the one after it, placed by its own match, does (its match started elsewhere).
-  const std::size_t p = previous_[k];
+  // odometry); the one after it, placed by its own match, does (its match started elsewhere),
+  // also across scans no match placed (waiting_before).
+  const std::size_t p = waiting_before(k);
   if (p != kNoNode && pending_map_[p] && pending_map_[k] &&
       odometry_agrees(p, placed_now(p, *pending_map_[p]), k, placed_now(k, *pending_map_[k]))) {
     believe_waiting(p);
@@ -225,7 +251,7 @@ void ScanGraph::offer_match_to_map(std::size_t scan, const Pose& placed,
   confirm_by_odometry(scan);
   // A re-match of an older scan: the robot's scan after it may already be in the map.
   for (std::size_t n = scan + 1; n < previous_.size() && pending_map_[scan]; ++n) {
-    if (previous_[n] == scan) confirm_by_odometry(n);
+    if (waiting_before(n) == scan) confirm_by_odometry(n);
   }
 }
 
@@ -265,8 +291,8 @@ bool ScanGraph::later_pair_confirms(std::size_t scan, const GraphEdge& edge) con
 bool ScanGraph::confirm_waiting(const GraphSolveReport& solve) {
   bool any = false;
   for (std::size_t n = 0; n < graph_.size(); ++n) {
-    const std::size_t p = previous_[n];
-    if (p == kNoNode || !pending_map_[p] || anchored_[p] || !anchored_[n]) continue;
+    const std::size_t p = waiting_before(n);
+    if (p == kNoNode || anchored_[p] || !anchored_[n]) continue;
     confirm_by_odometry(n);
     any = any || !pending_map_[p];
   }

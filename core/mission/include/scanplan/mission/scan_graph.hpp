@@ -194,6 +194,10 @@ class ScanGraph {
   bool odometry_agrees(std::size_t a, const Pose& a_placed, std::size_t b,
                        const Pose& b_placed) const;
   void confirm_by_odometry(std::size_t scan);
+  // Scans no match placed that a confirmation by odometry reaches across (waiting_before).
+  static constexpr std::size_t kMaxSkipped = 2;
+  std::size_t waiting_before(std::size_t scan) const;
+  double driven_between(std::size_t from, std::size_t to) const;
   bool agree(const Pose& a, const Pose& b) const;
   bool later_pair_confirms(std::size_t scan, const GraphEdge& edge) const;
   bool confirm_waiting(const GraphSolveReport& solve);
