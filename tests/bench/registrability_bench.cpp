@@ -5,11 +5,11 @@
 // (MissionPipeline::place, which changes nothing). Each candidate is forecast by every variant
 // on the same map: the baseline (every wall counts from anywhere, a wall's direction from the
 // cells within 2 of it: the forecast before 2026-12-07), RegistrabilityConfig::sided_walls
-// alone, and with wall_line_radius_cells too (the planner's). A candidate is forecast
-// registrable when the forecast keeps its whole score (factor 1); a match is right when applied
-// within 10 cm / 0.3° of the truth. Prints one JSON line: per variant the confusion counts and
-// how well pose_fixing and the score share rank right matches above failed ones (AUC). Usage:
-// registrability_bench [SEEDS=3] [SCANS=25] [PER_STEP=6] [WORLD.json] [SAMPLES.csv]
+// alone, with wall_line_radius_cells too, and with corner_faces too (the planner's). A candidate
+// is forecast registrable when the forecast keeps its whole score (factor 1); a match is right
+// when applied within 10 cm / 0.3° of the truth. Prints one JSON line: per variant the confusion
+// counts and how well pose_fixing and the score share rank right matches above failed ones (AUC).
+// Usage: registrability_bench [SEEDS=3] [SCANS=25] [PER_STEP=6] [WORLD.json] [SAMPLES.csv]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -35,9 +35,12 @@ struct Variant {
   const char* name;
   bool sided_walls;
   int wall_line_radius_cells;
+  bool corner_faces;
 };
-constexpr Variant kVariants[] = {
-    {"baseline", false, 0}, {"sided_walls", true, 0}, {"wall_lines", true, 6}};
+constexpr Variant kVariants[] = {{"baseline", false, 0, false},
+                                 {"sided_walls", true, 0, false},
+                                 {"wall_lines", true, 6, false},
+                                 {"corner_faces", true, 6, true}};
 constexpr int kVariantCount = sizeof kVariants / sizeof kVariants[0];
 
 struct Sample {
@@ -151,6 +154,7 @@ int main(int argc, char** argv) {
           PlannerConfig planner = mission.planner_config();
           planner.registrability.sided_walls = kVariants[v].sided_walls;
           planner.registrability.wall_line_radius_cells = kVariants[v].wall_line_radius_cells;
+          planner.registrability.corner_faces = kVariants[v].corner_faces;
           Candidate detail;
           evaluate(in, planner, c.position, &detail);
           if (detail.registrability) s.forecast[v] = *detail.registrability;

@@ -12,6 +12,23 @@
 
 namespace scanplan {
 
+namespace {
+
+// The unit direction through the middle of view sector s.
+const Eigen::Vector2d& sector_direction(int s) {
+  static const std::array<Eigen::Vector2d, kViewSectors> directions = [] {
+    std::array<Eigen::Vector2d, kViewSectors> d;
+    for (int k = 0; k < kViewSectors; ++k) {
+      const double a = (k + 0.5) * 2 * M_PI / kViewSectors;
+      d[static_cast<std::size_t>(k)] = {std::cos(a), std::sin(a)};
+    }
+    return d;
+  }();
+  return directions[static_cast<std::size_t>(s)];
+}
+
+}  // namespace
+
 RegistrabilityField::RegistrabilityField(const MlsMap& anchored, CellIndex origin, int cols,
                                          int rows, const RegistrabilityConfig& config)
     : config_(config),
@@ -68,11 +85,102 @@ RegistrabilityField::RegistrabilityField(const MlsMap& anchored, CellIndex origi
       Eigen::Matrix2d t = 0.5 * Eigen::Matrix2d::Identity();
       if (normal) t = *normal * normal->transpose();
       if (config.sided_walls) w.visible_from = visible_from(seen[cell_offset(i, j)], normal);
+      if (!normal && config.corner_faces) set_faces(w, seen[cell_offset(i, j)], i, j);
       w.t_xx = static_cast<float>(t(0, 0));
       w.t_xy = static_cast<float>(t(0, 1));
       w.t_yy = static_cast<float>(t(1, 1));
     }
   }
+}
+
+std::optional<std::pair<Eigen::Vector2d, Eigen::Vector2d>> RegistrabilityField::corner_arms(
+    int i, int j, int radius) const {
+  std::vector<Eigen::Vector2d> offsets;
+  for (int dj = -radius; dj <= radius; ++dj) {
+    for (int di = -radius; di <= radius; ++di) {
+      const int x = i + di, y = j + dj;
+      if ((di == 0 && dj == 0) || x < 0 || y < 0 || x >= cols_ || y >= rows_ ||
+          di * di + dj * dj > radius * radius) {
+        continue;
+      }
+      if (cells_[static_cast<std::size_t>(y) * static_cast<std::size_t>(cols_) +
+                 static_cast<std::size_t>(x)]
+              .wall) {
+        offsets.emplace_back(di, dj);
+      }
+    }
+  }
+  // Two arms spread the cells about evenly; the end of a wall two cells thick, which looks like
+  // a corner up close, spreads them along itself.
+  Eigen::Matrix2d spread = Eigen::Matrix2d::Zero();
+  for (const Eigen::Vector2d& e : offsets) spread += e * e.transpose();
+  const Eigen::Vector2d l =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(spread, Eigen::EigenvaluesOnly).eigenvalues();
+  if (offsets.size() < 4 || l[1] > 4 * l[0]) return std::nullopt;
+  // An arm: the wall cells near a ray from the cell (within 0.75 of a cell of it), their mean
+  // direction.
+  const auto arm = [&](const Eigen::Vector2d& u, Eigen::Vector2d& mean) {
+    int n = 0;
+    mean.setZero();
+    for (const Eigen::Vector2d& e : offsets) {
+      if (e.dot(u) >= 0.5 && std::abs(e.x() * u.y() - e.y() * u.x()) <= 0.75) {
+        mean += e.normalized();
+        ++n;
+      }
+    }
+    if (n > 0) mean.normalize();
+    return n;
+  };
+  int best1 = 0, best2 = 0;
+  Eigen::Vector2d u1, u2, mean;
+  for (const Eigen::Vector2d& e : offsets) {
+    const int n = arm(e.normalized(), mean);
+    if (n > best1) best1 = n, u1 = mean;
+  }
+  if (best1 < 2) return std::nullopt;
+  for (const Eigen::Vector2d& e : offsets) {
+    const Eigen::Vector2d u = e.normalized();
+    if (std::abs(u.dot(u1)) > std::cos(deg2rad(50))) continue;
+    const int n = arm(u, mean);
+    if (n > best2) best2 = n, u2 = mean;
+  }
+  if (best2 < 2 || std::abs(u1.dot(u2)) > std::cos(deg2rad(50))) return std::nullopt;
+  // The corner ends both arms: a wall going on past it (a T, a crossing) is no corner's face.
+  if (arm(-u1, mean) > 1 || arm(-u2, mean) > 1) return std::nullopt;
+  // Nothing between the arms: in a wall two cells thick, the cells beside one arm look like a
+  // second arm, with more of the wall between them.
+  const double turn = u1.x() * u2.y() - u1.y() * u2.x();
+  for (const Eigen::Vector2d& e : offsets) {
+    const double a = u1.x() * e.y() - u1.y() * e.x(), b = e.x() * u2.y() - e.y() * u2.x();
+    const bool between = a * turn > 0 && b * turn > 0;
+    const bool on_arm = std::abs(a) <= 0.75 * e.norm() || std::abs(b) <= 0.75 * e.norm();
+    if (between && !on_arm) return std::nullopt;
+  }
+  return std::make_pair(u1, u2);
+}
+
+void RegistrabilityField::set_faces(Cell& w, ViewSectors seen, int i, int j) const {
+  if (seen == 0) return;  // where its scanners stood is not known: nor which way it juts
+  const auto arms = corner_arms(i, j, std::max(2, config_.wall_radius_cells + 2));
+  if (!arms) return;
+  const auto& [u1, u2] = *arms;
+  // A face's outward normal is across its arm, away from the other arm where the corner juts out
+  // (its scanners stood outside the angle between the arms), towards it where it is recessed.
+  int inside = 0, outside = 0;
+  for (int s = 0; s < kViewSectors; ++s) {
+    if (!(seen >> s & 1)) continue;
+    const Eigen::Vector2d& d = sector_direction(s);
+    ++(d.dot(u1) > 0 && d.dot(u2) > 0 ? inside : outside);
+  }
+  const double towards = inside > outside ? 1.0 : -1.0;
+  Eigen::Vector2d n1(-u1.y(), u1.x()), n2(-u2.y(), u2.x());
+  if (towards * n1.dot(u2) < 0) n1 = -n1;
+  if (towards * n2.dot(u1) < 0) n2 = -n2;
+  w.n1x = static_cast<float>(n1.x());
+  w.n1y = static_cast<float>(n1.y());
+  w.n2x = static_cast<float>(n2.x());
+  w.n2y = static_cast<float>(n2.y());
+  w.faces = 2;
 }
 
 RegistrabilityField::WallLine RegistrabilityField::wall_line(
@@ -116,23 +224,6 @@ RegistrabilityField::WallLine RegistrabilityField::wall_line(
   line.normal = eig.eigenvectors().col(0);
   return line;
 }
-
-namespace {
-
-// The unit direction through the middle of view sector s.
-const Eigen::Vector2d& sector_direction(int s) {
-  static const std::array<Eigen::Vector2d, kViewSectors> directions = [] {
-    std::array<Eigen::Vector2d, kViewSectors> d;
-    for (int k = 0; k < kViewSectors; ++k) {
-      const double a = (k + 0.5) * 2 * M_PI / kViewSectors;
-      d[static_cast<std::size_t>(k)] = {std::cos(a), std::sin(a)};
-    }
-    return d;
-  }();
-  return directions[static_cast<std::size_t>(s)];
-}
-
-}  // namespace
 
 bool RegistrabilityField::seen_along(ViewSectors seen, const Eigen::Vector2d& normal) {
   if (seen == 0) return false;
@@ -197,13 +288,27 @@ void RegistrabilityField::Forecast::add(std::uint32_t o, int di, int dj) {
   if (!(c.visible_from >> view_sector(static_cast<float>(-px), static_cast<float>(-py)) & 1)) {
     return;
   }
+  double txx = c.t_xx, txy = c.t_xy, tyy = c.t_yy;
+  if (c.faces) {
+    // A corner: the faces this scan meets (it stands at −p from the cell), a cell or more out
+    // from their lines, which pass through the cell's centre only to within a cell (a face met
+    // at grazing holds few points anyway).
+    const double margin = f.cell_m_;
+    const bool one = c.n1x * -px + c.n1y * -py > margin;
+    const bool two = c.n2x * -px + c.n2y * -py > margin;
+    if (!one && !two) return;
+    const double k = one && two ? 0.5 : 1.0;
+    txx = k * ((one ? c.n1x * c.n1x : 0.0) + (two ? c.n2x * c.n2x : 0.0));
+    txy = k * ((one ? c.n1x * c.n1y : 0.0) + (two ? c.n2x * c.n2y : 0.0));
+    tyy = k * ((one ? c.n1y * c.n1y : 0.0) + (two ? c.n2y * c.n2y : 0.0));
+  }
   // The wall fixes the pose along its normal n: a row (n, p⊥·n) of the x, y, yaw Jacobian,
   // summed over the normals T = Σ n nᵀ stands for.
   const double qx = -py, qy = px;  // p⊥
-  const double tqx = c.t_xx * qx + c.t_xy * qy, tqy = c.t_xy * qx + c.t_yy * qy;
-  t_xx_ += w * c.t_xx;
-  t_xy_ += w * c.t_xy;
-  t_yy_ += w * c.t_yy;
+  const double tqx = txx * qx + txy * qy, tqy = txy * qx + tyy * qy;
+  t_xx_ += w * txx;
+  t_xy_ += w * txy;
+  t_yy_ += w * tyy;
   tp_x_ += w * tqx;
   tp_y_ += w * tqy;
   ptp_ += w * (qx * tqx + qy * tqy);
@@ -217,6 +322,7 @@ std::uint64_t RegistrabilityField::digest() const {
   std::uint64_t h = mix(std::uint64_t{0xF1E1D}, static_cast<std::uint64_t>(c.enabled));
   h = mix(h, static_cast<std::uint64_t>(c.sided_walls));
   h = mix(h, static_cast<std::uint64_t>(c.wall_line_radius_cells));
+  h = mix(h, static_cast<std::uint64_t>(c.corner_faces));
   for (const double v : {c.min_overlap_share, c.min_pose_fixing, c.floor_share, c.near_range_m,
                          c.inlier_distance_m, cell_m_})
     h = mix(h, v);
@@ -229,7 +335,8 @@ std::uint64_t RegistrabilityField::cell_digest(std::size_t offset) const {
   const std::uint64_t flags = c.mapped | (std::uint64_t{c.wall} << 8);
   const std::uint64_t h =
       mix(mix(mix(mix(mix(std::uint64_t{0xCE11}, flags), c.odds), c.t_xx), c.t_xy), c.t_yy);
-  return mix(h, std::uint64_t{c.visible_from});
+  const std::uint64_t faces = mix(mix(mix(mix(h, c.n1x), c.n1y), c.n2x), c.n2y);
+  return mix(mix(faces, std::uint64_t{c.faces}), std::uint64_t{c.visible_from});
 }
 
 Registrability RegistrabilityField::Forecast::result() const {

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "scanplan/geometry/cell_grid.hpp"
@@ -55,6 +56,14 @@ struct RegistrabilityConfig {
   // corner, look registrable, and every scan planned there was refused as a corridor
   // (issue 15). 0: off (the forecast before 2026-12-07).
   int wall_line_radius_cells = 6;
+  // Where the walls around a cell show no one direction but two arms of wall leave it (a
+  // building's corner), the corner fixes both directions only for a scan that sees both of its
+  // faces; from beside one face it fixes the pose across that face alone. On the campus the
+  // south building's corner counted as fixing every direction for scans in the strip before its
+  // south face, which see only that face, and gave them 86 % of their forecast along the strip:
+  // every scan planned there was refused as a corridor (issue 15). Off: a corner fixes every
+  // direction for any scan within a right angle of where it was seen (before 2026-12-07).
+  bool corner_faces = true;
   // A wall counts only for a scan on the side its scanners stood on (SurfacePatch::seen_from):
   // from the other side the scan meets another face, or none (on the campus, a building's far
   // face made a street look registrable). Off: every wall counts from anywhere (the forecast
@@ -142,6 +151,10 @@ class RegistrabilityField {
     // n nᵀ of the wall's normal (in the x-y plane); I/2 where the walls around have no one
     // direction (a post, a corner); zero where there is no wall.
     float t_xx = 0, t_xy = 0, t_yy = 0;
+    // A corner with two arms of wall (corner_faces): the outward normals of its faces. A scan
+    // meets a face only from the side its normal points to.
+    float n1x = 0, n1y = 0, n2x = 0, n2y = 0;
+    std::uint8_t faces = 0;  // 2 for such a corner, else 0
     // The directions (MlsMap's view sectors, from the cell) from which a scan meets the face
     // the map holds here: the side of the wall its scanners stood on (all, where unknown).
     ViewSectors visible_from = 0xFFFF;
@@ -157,6 +170,13 @@ class RegistrabilityField {
     std::optional<Eigen::Vector2d> normal;
   };
   WallLine wall_line(int i, int j, int radius, std::optional<double> max_off_line = {}) const;
+  // The two arms of wall leaving cell (i, j) within `radius` cells, as unit directions, where
+  // each holds two wall cells or more and they are 50–130° apart.
+  std::optional<std::pair<Eigen::Vector2d, Eigen::Vector2d>> corner_arms(int i, int j,
+                                                                         int radius) const;
+  // Marks wall cell `w` at (i, j) a corner with two faces when two arms leave it (corner_faces):
+  // their outward normals, from where its scanners stood (`seen`).
+  void set_faces(Cell& w, ViewSectors seen, int i, int j) const;
   // Whether a scanner in every sector of `seen` stood nearly along a line with `normal`.
   static bool seen_along(ViewSectors seen, const Eigen::Vector2d& normal);
   // The view sectors a wall cell is met from: those on the side of the wall (its `normal`, for
