@@ -27,6 +27,13 @@ const Eigen::Vector2d& sector_direction(int s) {
   return directions[static_cast<std::size_t>(s)];
 }
 
+// Σ e eᵀ over the offsets: how the cells spread about the cell they are taken from.
+Eigen::Matrix2d spread_of(const std::vector<Eigen::Vector2d>& offsets) {
+  Eigen::Matrix2d spread = Eigen::Matrix2d::Zero();
+  for (const Eigen::Vector2d& e : offsets) spread += e * e.transpose();
+  return spread;
+}
+
 }  // namespace
 
 RegistrabilityField::RegistrabilityField(const MlsMap& anchored, CellIndex origin, int cols,
@@ -93,14 +100,12 @@ RegistrabilityField::RegistrabilityField(const MlsMap& anchored, CellIndex origi
   }
 }
 
-std::optional<std::pair<Eigen::Vector2d, Eigen::Vector2d>> RegistrabilityField::corner_arms(
-    int i, int j, int radius) const {
+std::vector<Eigen::Vector2d> RegistrabilityField::wall_offsets(int i, int j, int radius) const {
   std::vector<Eigen::Vector2d> offsets;
   for (int dj = -radius; dj <= radius; ++dj) {
     for (int di = -radius; di <= radius; ++di) {
       const int x = i + di, y = j + dj;
-      if ((di == 0 && dj == 0) || x < 0 || y < 0 || x >= cols_ || y >= rows_ ||
-          di * di + dj * dj > radius * radius) {
+      if (x < 0 || y < 0 || x >= cols_ || y >= rows_ || di * di + dj * dj > radius * radius) {
         continue;
       }
       if (cells_[static_cast<std::size_t>(y) * static_cast<std::size_t>(cols_) +
@@ -110,12 +115,18 @@ std::optional<std::pair<Eigen::Vector2d, Eigen::Vector2d>> RegistrabilityField::
       }
     }
   }
+  return offsets;
+}
+
+std::optional<std::pair<Eigen::Vector2d, Eigen::Vector2d>> RegistrabilityField::corner_arms(
+    int i, int j, int radius) const {
+  std::vector<Eigen::Vector2d> offsets = wall_offsets(i, j, radius);
+  std::erase_if(offsets, [](const Eigen::Vector2d& e) { return e.isZero(); });
   // Two arms spread the cells about evenly; the end of a wall two cells thick, which looks like
   // a corner up close, spreads them along itself.
-  Eigen::Matrix2d spread = Eigen::Matrix2d::Zero();
-  for (const Eigen::Vector2d& e : offsets) spread += e * e.transpose();
   const Eigen::Vector2d l =
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(spread, Eigen::EigenvaluesOnly).eigenvalues();
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(spread_of(offsets), Eigen::EigenvaluesOnly)
+          .eigenvalues();
   if (offsets.size() < 4 || l[1] > 4 * l[0]) return std::nullopt;
   // An arm: the wall cells near a ray from the cell (within 0.75 of a cell of it), their mean
   // direction.
@@ -131,6 +142,7 @@ std::optional<std::pair<Eigen::Vector2d, Eigen::Vector2d>> RegistrabilityField::
     if (n > 0) mean.normalize();
     return n;
   };
+  const double apart = std::cos(deg2rad(50));  // the arms at least 50° apart
   int best1 = 0, best2 = 0;
   Eigen::Vector2d u1, u2, mean;
   for (const Eigen::Vector2d& e : offsets) {
@@ -140,15 +152,15 @@ std::optional<std::pair<Eigen::Vector2d, Eigen::Vector2d>> RegistrabilityField::
   if (best1 < 2) return std::nullopt;
   for (const Eigen::Vector2d& e : offsets) {
     const Eigen::Vector2d u = e.normalized();
-    if (std::abs(u.dot(u1)) > std::cos(deg2rad(50))) continue;
+    if (std::abs(u.dot(u1)) > apart) continue;
     const int n = arm(u, mean);
     if (n > best2) best2 = n, u2 = mean;
   }
-  if (best2 < 2 || std::abs(u1.dot(u2)) > std::cos(deg2rad(50))) return std::nullopt;
+  if (best2 < 2 || std::abs(u1.dot(u2)) > apart) return std::nullopt;
   // The corner ends both arms: a wall going on past it (a T, a crossing) is no corner's face.
   if (arm(-u1, mean) > 1 || arm(-u2, mean) > 1) return std::nullopt;
-  // Nothing between the arms: in a wall two cells thick, the cells beside one arm look like a
-  // second arm, with more of the wall between them.
+  // Nothing between the arms but the arms: the corner of a solid block (rubble, a thick pier)
+  // holds wall cells inside the angle too, and is no two faces.
   const double turn = u1.x() * u2.y() - u1.y() * u2.x();
   for (const Eigen::Vector2d& e : offsets) {
     const double a = u1.x() * e.y() - u1.y() * e.x(), b = e.x() * u2.y() - e.y() * u2.x();
@@ -180,32 +192,16 @@ void RegistrabilityField::set_faces(Cell& w, ViewSectors seen, int i, int j) con
   w.n1y = static_cast<float>(n1.y());
   w.n2x = static_cast<float>(n2.x());
   w.n2y = static_cast<float>(n2.y());
-  w.faces = 2;
+  w.faces = 1;
 }
 
 RegistrabilityField::WallLine RegistrabilityField::wall_line(
     int i, int j, int radius, std::optional<double> max_off_line) const {
   WallLine line;
-  std::vector<Eigen::Vector2d> offsets;
-  Eigen::Matrix2d spread = Eigen::Matrix2d::Zero();
-  for (int dj = -radius; dj <= radius; ++dj) {
-    for (int di = -radius; di <= radius; ++di) {
-      const int x = i + di, y = j + dj;
-      if (x < 0 || y < 0 || x >= cols_ || y >= rows_ || di * di + dj * dj > radius * radius) {
-        continue;
-      }
-      if (!cells_[static_cast<std::size_t>(y) * static_cast<std::size_t>(cols_) +
-                  static_cast<std::size_t>(x)]
-               .wall) {
-        continue;
-      }
-      offsets.emplace_back(di, dj);
-      spread += offsets.back() * offsets.back().transpose();
-    }
-  }
+  const std::vector<Eigen::Vector2d> offsets = wall_offsets(i, j, radius);
   line.cells = static_cast<int>(offsets.size());
   if (line.cells < 3) return line;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(spread);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(spread_of(offsets));
   // The spread is taken about the cell itself, so its smaller eigenvalue per cell is how far off
   // a line through the cell the others lie.
   const Eigen::Vector2d& l = eig.eigenvalues();

@@ -154,7 +154,7 @@ class RegistrabilityField {
     // A corner with two arms of wall (corner_faces): the outward normals of its faces. A scan
     // meets a face only from the side its normal points to.
     float n1x = 0, n1y = 0, n2x = 0, n2y = 0;
-    std::uint8_t faces = 0;  // 2 for such a corner, else 0
+    std::uint8_t faces = 0;  // 1 for such a corner (n1, n2 set), else 0
     // The directions (MlsMap's view sectors, from the cell) from which a scan meets the face
     // the map holds here: the side of the wall its scanners stood on (all, where unknown).
     ViewSectors visible_from = 0xFFFF;
@@ -170,6 +170,8 @@ class RegistrabilityField {
     std::optional<Eigen::Vector2d> normal;
   };
   WallLine wall_line(int i, int j, int radius, std::optional<double> max_off_line = {}) const;
+  // The offsets of the wall cells within `radius` cells of cell (i, j), it included.
+  std::vector<Eigen::Vector2d> wall_offsets(int i, int j, int radius) const;
   // The two arms of wall leaving cell (i, j) within `radius` cells, as unit directions, where
   // each holds two wall cells or more and they are 50–130° apart.
   std::optional<std::pair<Eigen::Vector2d, Eigen::Vector2d>> corner_arms(int i, int j,
