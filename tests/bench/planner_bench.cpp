@@ -370,11 +370,19 @@ struct Campus {
 // One planning step per policy on the five-scan map: best of 3 (the machine is shared).
 nlohmann::json time_policies(const PlanInput& input, const PlannerConfig& base) {
   nlohmann::json policies = nlohmann::json::object();
-  for (const PlannerPolicy p :
-       {PlannerPolicy::kPaper, PlannerPolicy::kExhaustive, PlannerPolicy::kTravel,
-        PlannerPolicy::kNearestFrontier, PlannerPolicy::kRandom}) {
+  // "paper-full-screening": the baseline of the sparser screening, its sample through the
+  // climbs' own fan.
+  const std::vector<std::pair<PlannerPolicy, std::string>> runs = {
+      {PlannerPolicy::kPaper, "paper"},
+      {PlannerPolicy::kPaper, "paper-full-screening"},
+      {PlannerPolicy::kExhaustive, "exhaustive"},
+      {PlannerPolicy::kTravel, "travel"},
+      {PlannerPolicy::kNearestFrontier, "nearest-frontier"},
+      {PlannerPolicy::kRandom, "random"}};
+  for (const auto& [p, name] : runs) {
     PlannerConfig cfg = base;
     cfg.policy = p;
+    if (name == "paper-full-screening") cfg.screening_coarsening = 1;
     double best = 1e300, best_cpu = 1e300;
     Plan plan;
     for (int r = 0; r < 3; ++r) {
@@ -390,7 +398,7 @@ nlohmann::json time_policies(const PlanInput& input, const PlannerConfig& base) 
       j["xy"] = {c.position.x(), c.position.y()};
       j["travel_m"] = c.travel_m;
     }
-    policies[std::string(policy_name(p))] = j;
+    policies[name] = j;
   }
   return policies;
 }
@@ -504,6 +512,7 @@ double share(std::size_t part, std::size_t whole) {
 // a memo kept over the loop (GainMemo, issue 19): the same plans, and what reuse saves.
 nlohmann::json loop_study(Campus& campus, const PlannerConfig& base, int loop_steps) {
   std::vector<double> gaps, gaps_plain, iou_new, iou_all, gain_ratio, ms_paper, ms_exhaustive;
+  std::vector<double> gaps_full_screening, ms_paper_full_screening;
   std::vector<double> ms_paper_memo, ms_exhaustive_memo, reused_paper, reused_exhaustive;
   GainMemo paper_memo, exhaustive_memo;
   bool memo_plans_same = true;
@@ -514,6 +523,9 @@ nlohmann::json loop_study(Campus& campus, const PlannerConfig& base, int loop_st
     cfg.seed = static_cast<std::uint64_t>(1000 + step);
     cfg.policy = PlannerPolicy::kPaper;
     const Plan paper = plan_next_scan(in, cfg);
+    cfg.screening_coarsening = 1;  // the sample through the climbs' own fan, the baseline
+    const Plan full_screening = plan_next_scan(in, cfg);
+    cfg.screening_coarsening = base.screening_coarsening;
     cfg.hill_climb_samples = 0;  // the paper's plain random starts, for comparison
     const Plan random_starts = plan_next_scan(in, cfg);
     cfg.hill_climb_samples = base.hill_climb_samples;
@@ -522,6 +534,7 @@ nlohmann::json loop_study(Campus& campus, const PlannerConfig& base, int loop_st
     const Plan best = plan_next_scan(in, cfg);
     if (best.ranked.empty()) break;
     ms_paper.push_back(paper.plan_ms);
+    ms_paper_full_screening.push_back(full_screening.plan_ms);
     ms_exhaustive.push_back(best.plan_ms);
     PlanInput with_memo = in;
     with_memo.memo = &exhaustive_memo;
@@ -540,6 +553,9 @@ nlohmann::json loop_study(Campus& campus, const PlannerConfig& base, int loop_st
     const double f_random = random_starts.ranked.empty() ? 0.0 : random_starts.ranked.front().f;
     gaps.push_back((f_best - f_paper) / f_best);
     gaps_plain.push_back((f_best - f_random) / f_best);
+    gaps_full_screening.push_back(
+        (f_best - (full_screening.ranked.empty() ? 0.0 : full_screening.ranked.front().f)) /
+        f_best);
     sum_f_best += f_best;
     sum_f_paper += f_paper;
 
@@ -560,6 +576,12 @@ nlohmann::json loop_study(Campus& campus, const PlannerConfig& base, int loop_st
           {"paper_gap_mean", mean_of(gaps)},
           {"paper_gap_max", gaps.empty() ? 0.0 : *std::max_element(gaps.begin(), gaps.end())},
           {"paper_random_starts_gap_mean", mean_of(gaps_plain)},
+          {"paper_full_screening_gap_mean", mean_of(gaps_full_screening)},
+          {"paper_full_screening_gap_max",
+           gaps_full_screening.empty()
+               ? 0.0
+               : *std::max_element(gaps_full_screening.begin(), gaps_full_screening.end())},
+          {"loop_ms_paper_full_screening_mean", mean_of(ms_paper_full_screening)},
           {"paper_f_share_of_optimum", sum_f_best > 0 ? sum_f_paper / sum_f_best : 1.0},
           {"loop_ms_paper_mean", mean_of(ms_paper)},
           {"loop_ms_exhaustive_mean", mean_of(ms_exhaustive)},

@@ -6,6 +6,7 @@
 #include <functional>
 #include <mutex>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -60,6 +61,7 @@ void check_config(const PlannerConfig& c) {
   if (c.hill_climb_starts < 1) fail("hill_climb_starts must be at least 1");
   if (!(c.hill_climb_step_m > 0)) fail("hill_climb_step_m must be greater than zero");
   if (c.hill_climb_samples < 0) fail("hill_climb_samples must be zero or more");
+  if (c.screening_coarsening < 1) fail("screening_coarsening must be at least 1");
   if (!(c.lattice_m > 0)) fail("lattice_m must be greater than zero");
   if (!(c.completion_weight >= 0)) fail("completion_weight must be zero or more");
   if (c.max_candidates < 1) fail("max_candidates must be at least 1");
@@ -362,22 +364,25 @@ std::vector<std::int32_t> lattice_sites(const Sites& sites, double lattice_m, do
   return which;
 }
 
-// Where hill climbing starts, the sites already evaluated to choose them, and the score it
-// climbs (its scale set by the best F seen so far).
+// Where hill climbing starts, the sites already evaluated with the full fan to choose them,
+// and the score it climbs (its scale set by the best F seen so far).
 struct ClimbStarts {
   std::vector<std::int32_t> sites;
   std::vector<Scored> screened;
   Scorer score;
-  std::size_t evaluations = 0;  // of the starts themselves, outside `screened`
+  std::size_t evaluations = 0;  // of the screening's sample, outside `screened`
 };
 
 // The starts are the best of a random sample rather than the sample's first few: the same
 // randomised initial locations, but the climbs begin on the hills worth climbing. The sample is
 // a lattice at a random offset, about hill_climb_samples cells on the movable region: random
 // like the paper's starts, but spread evenly, so no part of the region is left without a start
-// nearby.
-ClimbStarts screened_starts(SiteGains& gain, const Sites& sites, const PlannerConfig& cfg,
-                            int threads, const ScorerFor& scorer_for, SplitMix& rng) {
+// nearby. `screen` evaluates the sample (a sparser fan, PlannerConfig::screening_coarsening);
+// the starts, and the site of the sample's best F that scales the score, are then evaluated
+// with the full fan, so the score a climb compares and every F kept are the full fan's.
+ClimbStarts screened_starts(SiteGains& gain, SiteGains& screen, const Sites& sites,
+                            const PlannerConfig& cfg, int threads, const ScorerFor& scorer_for,
+                            SplitMix& rng) {
   ClimbStarts out;
   const int stride = std::max(1, static_cast<int>(std::lround(std::sqrt(
                                      static_cast<double>(sites.size()) / cfg.hill_climb_samples))));
@@ -392,18 +397,41 @@ ClimbStarts screened_starts(SiteGains& gain, const Sites& sites, const PlannerCo
   }
   // A region thinner than the lattice still gets a start.
   if (sample.empty()) sample.push_back(static_cast<std::int32_t>(rng.below(sites.size())));
-  out.screened = evaluate_sites(gain, sample, threads);
-  double best_f = 0;
-  for (const Scored& x : out.screened) best_f = std::max(best_f, x.gain.f);
-  out.score = scorer_for(best_f);
-  for (Scored& x : out.screened) x.score = out.score(x.site, x.gain);
-  std::vector<Scored> order = out.screened;
+  std::vector<Scored> looked = evaluate_sites(screen, sample, threads);
+  const auto best_f_of = [](const std::vector<Scored>& v) {
+    double best = 0;
+    for (const Scored& x : v) best = std::max(best, x.gain.f);
+    return best;
+  };
+  const Scorer rough = scorer_for(best_f_of(looked));
+  for (Scored& x : looked) x.score = rough(x.site, x.gain);
+  std::vector<Scored> order = looked;
   std::stable_sort(order.begin(), order.end(),
                    [](const Scored& a, const Scored& b) { return a.score > b.score; });
+  std::vector<std::int32_t> chosen;
   for (std::size_t k = 0;
-       k < order.size() && static_cast<int>(out.sites.size()) < cfg.hill_climb_starts; ++k) {
-    out.sites.push_back(order[k].site);
+       k < order.size() && static_cast<int>(chosen.size()) < cfg.hill_climb_starts; ++k) {
+    chosen.push_back(order[k].site);
   }
+  if (&screen == &gain) {
+    out.screened = std::move(looked);
+    out.sites = std::move(chosen);
+    out.score = scorer_for(best_f_of(out.screened));
+    for (Scored& x : out.screened) x.score = out.score(x.site, x.gain);
+    return out;
+  }
+  out.evaluations = looked.size();
+  const auto most_f =
+      std::max_element(looked.begin(), looked.end(), [](const Scored& a, const Scored& b) {
+        return a.gain.f != b.gain.f ? a.gain.f < b.gain.f : a.site > b.site;
+      });
+  std::vector<std::int32_t> again = chosen;
+  if (std::find(again.begin(), again.end(), most_f->site) == again.end())
+    again.push_back(most_f->site);
+  out.screened = evaluate_sites(gain, again, threads);
+  out.score = scorer_for(best_f_of(out.screened));
+  for (Scored& x : out.screened) x.score = out.score(x.site, x.gain);
+  out.sites = std::move(chosen);
   return out;
 }
 
@@ -423,12 +451,15 @@ ClimbStarts random_starts(SiteGains& gain, const Sites& sites, const PlannerConf
 }
 
 // One climb from `start`: to the best 8-neighbour at the current move length while the score
-// improves, then at half the move. Returns every site it evaluated, in order.
-std::vector<Scored> climb(SiteGains& gain, const Sites& sites, std::int32_t start, int first_stride,
-                          const Scorer& score, VisibilityPredictor::Workspace& ws) {
+// improves, then at half the move. Returns every site it evaluated, in order; `start_score`,
+// when the start was evaluated already, is its score.
+std::vector<Scored> climb(SiteGains& gain, const Sites& sites, std::int32_t start,
+                          std::optional<double> start_score, int first_stride, const Scorer& score,
+                          VisibilityPredictor::Workspace& ws) {
   static constexpr int kDx[8] = {1, 1, 0, -1, -1, -1, 0, 1};
   static constexpr int kDy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
   std::unordered_map<std::int32_t, double> memo;
+  if (start_score) memo.emplace(start, *start_score);
   std::vector<Scored> seen;
   const auto value_at = [&](std::int32_t s) {
     const auto it = memo.find(s);
@@ -466,13 +497,14 @@ std::vector<Scored> climb(SiteGains& gain, const Sites& sites, std::int32_t star
 // Paper §3.4: hill climbing on F (or another score) from several random starts. Climbs run in
 // parallel, each with its own memory of evaluated cells, so the result and the count of
 // evaluations are the same whatever the thread count.
-std::vector<Scored> hill_climb(SiteGains& gain, const Sites& sites, const PlannerConfig& cfg,
-                               double cell_m, int threads, const ScorerFor& scorer_for,
-                               std::size_t& evaluations) {
+std::vector<Scored> hill_climb(SiteGains& gain, SiteGains& screen, const Sites& sites,
+                               const PlannerConfig& cfg, double cell_m, int threads,
+                               const ScorerFor& scorer_for, std::size_t& evaluations) {
   SplitMix rng(cfg.seed);
-  const ClimbStarts starts = cfg.hill_climb_samples > 0
-                                 ? screened_starts(gain, sites, cfg, threads, scorer_for, rng)
-                                 : random_starts(gain, sites, cfg, scorer_for, rng);
+  const ClimbStarts starts =
+      cfg.hill_climb_samples > 0
+          ? screened_starts(gain, screen, sites, cfg, threads, scorer_for, rng)
+          : random_starts(gain, sites, cfg, scorer_for, rng);
   const int first_stride =
       std::max(1, static_cast<int>(std::lround(cfg.hill_climb_step_m / cell_m)));
   std::vector<std::vector<Scored>> visited(starts.sites.size());
@@ -481,7 +513,13 @@ std::vector<Scored> hill_climb(SiteGains& gain, const Sites& sites, const Planne
     auto ws = gain.workspace();
 #pragma omp for schedule(dynamic, 1)
     for (std::size_t k = 0; k < starts.sites.size(); ++k) {
-      visited[k] = climb(gain, sites, starts.sites[k], first_stride, starts.score, ws);
+      const std::int32_t start = starts.sites[k];
+      const auto known = std::find_if(starts.screened.begin(), starts.screened.end(),
+                                      [&](const Scored& s) { return s.site == start; });
+      visited[k] =
+          climb(gain, sites, start,
+                known != starts.screened.end() ? std::optional(known->score) : std::nullopt,
+                first_stride, starts.score, ws);
     }
   }
   std::vector<Scored> all;
@@ -582,14 +620,14 @@ std::optional<Eigen::Vector3d> nearest_floor(const MlsMap& map, const Eigen::Vec
 }
 
 // The policy's choice among the sites, best first (PlannerConfig::policy).
-std::vector<Scored> choose(const PlannerConfig& cfg, SiteGains& gain, const Sites& sites,
-                           const RegionMap& regions, double cell_m, int threads,
+std::vector<Scored> choose(const PlannerConfig& cfg, SiteGains& gain, SiteGains& screen,
+                           const Sites& sites, const RegionMap& regions, double cell_m, int threads,
                            std::size_t& evaluations) {
   std::vector<Scored> chosen;
   switch (cfg.policy) {
     case PlannerPolicy::kPaper: {
-      chosen = rank(hill_climb(gain, sites, cfg, cell_m, threads, gain_only, evaluations), sites,
-                    cfg, cell_m);
+      chosen = rank(hill_climb(gain, screen, sites, cfg, cell_m, threads, gain_only, evaluations),
+                    sites, cfg, cell_m);
       break;
     }
     case PlannerPolicy::kExhaustive: {
@@ -615,8 +653,8 @@ std::vector<Scored> choose(const PlannerConfig& cfg, SiteGains& gain, const Site
           return registrable_f(g) - per_m * std::max(0.0, drive - free_m);
         };
       };
-      chosen = rank(hill_climb(gain, sites, cfg, cell_m, threads, traded, evaluations), sites, cfg,
-                    cell_m);
+      chosen = rank(hill_climb(gain, screen, sites, cfg, cell_m, threads, traded, evaluations),
+                    sites, cfg, cell_m);
       break;
     }
     case PlannerPolicy::kNearestFrontier: {
@@ -750,10 +788,25 @@ Plan plan_next_scan(const PlanInput& in, const PlannerConfig& cfg) {
   }
   const int threads = thread_count(cfg);
   SiteGains gains(gain, sites, memo, threads);
+  // The climbs' screening looks through a sparser fan (PlannerConfig::screening_coarsening).
+  std::optional<ScanGainEvaluator> rough;
+  const bool climbs = cfg.policy == PlannerPolicy::kPaper || cfg.policy == PlannerPolicy::kTravel;
+  if (climbs && cfg.hill_climb_samples > 0 && cfg.screening_coarsening > 1) {
+    VisibilityConfig sparse = cfg.visibility;
+    sparse.azimuth_step_deg = std::min(90.0, sparse.azimuth_step_deg * cfg.screening_coarsening);
+    sparse.max_ray_spacing_m *= cfg.screening_coarsening;
+    rough.emplace(in.map, claims.empty() ? plan.regions : claimed_regions, cfg.alpha, cfg.regions,
+                  sparse, field ? &*field : nullptr);
+  }
+  std::optional<SiteGains> rough_gains;
+  if (rough) rough_gains.emplace(*rough, sites, nullptr, threads);
   const std::vector<Scored> chosen =
-      choose(cfg, gains, sites, plan.regions, in.map.cell_m(), threads, plan.evaluations);
+      choose(cfg, gains, rough_gains ? *rough_gains : gains, sites, plan.regions, in.map.cell_m(),
+             threads, plan.evaluations);
   plan.reused = gains.keep_fresh();
-  plan.best_gain_m2 = gains.best_gain();
+  // A place the screening saw gain at counts though no climb went there: while one is left the
+  // mission is not done (Plan::best_gain_m2).
+  plan.best_gain_m2 = std::max(gains.best_gain(), rough_gains ? rough_gains->best_gain() : 0.0);
   plan.ranked = to_candidates(chosen, sites, in.map, travel);
   return finish();
 }

@@ -227,6 +227,31 @@ TEST_F(WallYard, EvaluateAgreesWithThePlan) {
   EXPECT_DOUBLE_EQ(best.f, 0.5 * best.gain_unscanned_m2 + 0.5 * best.gain_low_res_m2);
 }
 
+// The screening's sparser fan only chooses where the climbs start: every candidate of a paper
+// or travel plan carries the full fan's F, and the climbs still reach the optimum.
+TEST_F(WallYard, TheSparseScreeningOnlyChoosesWhereToClimb) {
+  for (const PlannerPolicy p : {PlannerPolicy::kPaper, PlannerPolicy::kTravel}) {
+    PlannerConfig cfg;
+    cfg.policy = p;
+    cfg.screening_coarsening = 4;
+    const Plan plan = plan_next_scan(input(), cfg);
+    ASSERT_FALSE(plan.ranked.empty()) << policy_name(p);
+    for (const Candidate& c : plan.ranked) {
+      Candidate full;
+      EXPECT_DOUBLE_EQ(evaluate(input(), cfg, c.position, &full), c.f) << policy_name(p);
+      EXPECT_DOUBLE_EQ(full.gain_unscanned_m2, c.gain_unscanned_m2) << policy_name(p);
+    }
+    EXPECT_TRUE(past_the_wall(plan.ranked.front())) << policy_name(p);
+    // The screening's own looks are counted, and a plan through the full fan looks as often.
+    cfg.screening_coarsening = 1;
+    const Plan same_fan = plan_next_scan(input(), cfg);
+    EXPECT_GT(plan.evaluations, 500u) << policy_name(p);
+    EXPECT_NEAR(static_cast<double>(plan.evaluations), static_cast<double>(same_fan.evaluations),
+                0.2 * same_fan.evaluations)
+        << policy_name(p);
+  }
+}
+
 TEST_F(WallYard, NothingLeftToScanGivesAnEmptyPlan) {
   // A target 10 m around the scan point: all of it scan-completed.
   const TargetRegion small = TargetRegion::rectangle({35, 15}, {45, 25});
@@ -249,6 +274,9 @@ TEST_F(WallYard, ConfigOutOfRangeIsRefused) {
   EXPECT_THROW(plan_next_scan(input(), cfg), std::invalid_argument);
   cfg = {};
   cfg.hill_climb_starts = 0;
+  EXPECT_THROW(plan_next_scan(input(), cfg), std::invalid_argument);
+  cfg = {};
+  cfg.screening_coarsening = 0;
   EXPECT_THROW(plan_next_scan(input(), cfg), std::invalid_argument);
   cfg = {};
   cfg.lattice_m = 0;

@@ -44,6 +44,12 @@ struct PlannerConfig {
   // steps on the campus this brings the climbs within 0.6% of the exhaustive optimum on
   // average, against 6% from purely random starts (docs/benchmarks.md).
   int hill_climb_samples = 1024;
+  // The screening of those samples predicts each scan with rays this many times sparser in
+  // azimuth (azimuth_step_deg and max_ray_spacing_m multiplied; 1: the climbs' own fan). It only
+  // ranks where to start: every start, and every F a plan reports, is evaluated with the full
+  // fan. Sparser rays miss a share of the far cells at every site alike, so the ranking of the
+  // sample holds while each look costs about half (docs/benchmarks.md, issue 19).
+  int screening_coarsening = 3;
   double lattice_m = 1.0;  // exhaustive: candidate spacing, in whole cells
   // exhaustive: ranks by F + completion_weight · area((U∪M_A)∩C_B), so that of two points
   // whose F differs by less than a few per cent (within the prediction's own error) the one
