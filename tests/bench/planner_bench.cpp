@@ -235,6 +235,7 @@ ClosedLoopConfig study_config(const World& world, PlannerPolicy p, int seed, int
   cfg.planner.visibility = VisibilityConfig::from_scanner(world.scanner);
   cfg.planner.travel_cost_per_m = travel.travel_cost_per_m;
   cfg.planner.travel_free_m = travel.travel_free_m;
+  cfg.planner.screening_coarsening = travel.screening_coarsening;
   cfg.seed = static_cast<std::uint64_t>(seed);
   cfg.max_scans = max_scans;
   cfg.stop_at_coverage_pct = 95.0;
@@ -278,7 +279,8 @@ int coverage_study(int seeds, const std::string& policies, const std::string& wo
                         {"seeds", seeds},
                         {"max_scans", max_scans},
                         {"travel_cost_per_m", travel.travel_cost_per_m},
-                        {"travel_free_m", travel.travel_free_m}};
+                        {"travel_free_m", travel.travel_free_m},
+                        {"screening_coarsening", travel.screening_coarsening}};
   for (const PlannerPolicy p : parse_policies(policies)) {
     std::vector<double> scans, path, detected13, plan_ms;
     nlohmann::json curves = nlohmann::json::array();
@@ -599,7 +601,8 @@ nlohmann::json loop_study(Campus& campus, const PlannerConfig& base, int loop_st
 
 int main(int argc, char** argv) {
   if (argc > 3 && std::string(argv[1]) == "--coverage") {
-    // --travel-cost X and --travel-free M anywhere after the policies override the defaults.
+    // --travel-cost X, --travel-free M and --screening K (PlannerConfig::screening_coarsening)
+    // anywhere after the policies override the defaults.
     PlannerConfig travel;
     std::vector<std::string> rest;
     for (int i = 4; i < argc; ++i) {
@@ -608,6 +611,8 @@ int main(int argc, char** argv) {
         travel.travel_cost_per_m = std::stod(argv[++i]);
       } else if (a == "--travel-free" && i + 1 < argc) {
         travel.travel_free_m = std::stod(argv[++i]);
+      } else if (a == "--screening" && i + 1 < argc) {
+        travel.screening_coarsening = std::stoi(argv[++i]);
       } else {
         rest.push_back(a);
       }
