@@ -68,9 +68,11 @@ json dropped_json(const DroppedReturns& d) {
           {"saturated", d.saturated}};
 }
 
-json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas, bool in_map) {
+json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas, bool in_map,
+               const std::optional<std::string>& outside) {
   return {{"id", s.id},
           {"in_map", in_map},
+          {"outside", outside ? json(*outside) : json(nullptr)},
           {"robot", s.robot},
           {"points", s.points},
           {"estimated", pose_json(s.estimated)},

@@ -29,8 +29,10 @@ nlohmann::json not_in_map_json(const std::vector<ScanIntake::NotInMap>& scans);
 // What drop_bad_returns left out of a scan, by kind.
 nlohmann::json dropped_json(const DroppedReturns& d);
 // `in_map`: false for a scan waiting outside the map for a match that ties it in (and for
-// one the operator took out).
-nlohmann::json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas, bool in_map);
+// one the operator took out); `outside`: why such a scan waits (LiveMap::waiting_reasons), null
+// when not given.
+nlohmann::json scan_json(const StoredScan& s, const std::optional<MapAreas>& areas, bool in_map,
+                         const std::optional<std::string>& outside = std::nullopt);
 nlohmann::json candidate_json(const CandidateRecord& r, const std::string& robot,
                               std::uint64_t plan);
 // A plan without its candidates: {id, based_on_scan, robot, policy, alpha, plan_ms, candidates}.

@@ -209,6 +209,7 @@ LiveMap::Followed LiveMap::follow_mission(std::vector<StoredScan> scans,
       f.unencoded.push_back(scans[i].id);
     }
     in_map[i] = now_in ? 1 : 0;
+    f.outside.push_back(mission_.outside_reason(i));
     MapCorrected& c = f.corrected;
     if (i == newest) {
       if (moved || !now_in) c.poses.push_back({scans[i].id, now, now_in});
@@ -255,6 +256,7 @@ void LiveMap::commit(Followed f) {
   scans_ = std::move(f.scans);
   placed_ = std::move(f.placed);
   in_map_ = std::move(f.in_map);
+  outside_ = std::move(f.outside);
   point_count_ = 0;
   bounds_ = Bounds3{};
   for (std::size_t i = 0; i < scans_.size(); ++i) {
@@ -531,6 +533,15 @@ std::vector<std::int64_t> LiveMap::waiting() const {
   return out;
 }
 
+std::map<std::int64_t, std::string> LiveMap::waiting_reasons() const {
+  std::lock_guard lock(mutex_);
+  std::map<std::int64_t, std::string> out;
+  for (std::size_t i = 0; i < scans_.size(); ++i) {
+    if (!in_map_[i]) out[scans_[i].id] = i < outside_.size() ? outside_[i] : "";
+  }
+  return out;
+}
+
 std::optional<StoredScan> LiveMap::last_scan() const {
   std::lock_guard lock(mutex_);
   if (scans_.empty()) return std::nullopt;
@@ -610,6 +621,7 @@ LiveMap::Rebuilt LiveMap::rebuild(const std::vector<StoredScan>& keep, const Sca
     s.placed = mission_.cloud_poses()[i];
     f.placed.push_back(mission_.placed_scans()[i]);
     f.in_map.push_back(mission_.in_map(i) ? 1 : 0);
+    f.outside.push_back(mission_.outside_reason(i));
     f.bounds.push_back(bounds_of(*f.placed.back()));
     const auto was = held.find(s.id);
     const auto chunk = chunks_.find(s.id);

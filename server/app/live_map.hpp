@@ -143,6 +143,8 @@ class LiveMap {
   std::vector<StoredScan> scans() const;
   // The scans waiting outside the map for a match that ties them in, ascending.
   std::vector<std::int64_t> waiting() const;
+  // Why each of them waits (MissionPipeline::outside_reason), by id.
+  std::map<std::int64_t, std::string> waiting_reasons() const;
   // What the map holds (the scans not waiting outside it), each scan's points in the map frame
   // as drawn, with its stored record: what the exports write.
   struct Held {
@@ -205,6 +207,7 @@ class LiveMap {
   // thread, never copied whole.
   std::vector<std::shared_ptr<const PointCloud>> placed_;
   std::vector<std::uint8_t> in_map_;  // per scan: shown (not waiting outside the map)
+  std::vector<std::string> outside_;  // per scan: why it waits outside the map (Followed)
   std::size_t point_count_ = 0;
   Bounds3 bounds_;  // of all points, kept as scans arrive: the session endpoint is polled often
   std::shared_ptr<const std::string> encoded_;  // the whole map up to encoded_last_scan_
@@ -248,6 +251,7 @@ class LiveMap {
     std::vector<StoredScan> scans;
     std::vector<std::shared_ptr<const PointCloud>> placed;
     std::vector<std::uint8_t> in_map;
+    std::vector<std::string> outside;  // per scan: why not in the map (empty when in it)
     std::vector<Bounds3> bounds;
     std::vector<std::int64_t> unencoded;  // ids whose chunk must be made anew
     MapCorrected corrected;

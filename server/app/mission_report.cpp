@@ -138,8 +138,8 @@ std::string scans_section(const ReportInput& in) {
                                      num(100 * s.match->inlier_ratio, 0) + " % on the map)"
                                : "not applied: " + escaped(s.match->reason);
     }
-    if (std::find(in.waiting.begin(), in.waiting.end(), s.id) != in.waiting.end()) {
-      match += "; waiting outside the map for a match that ties it in";
+    if (const auto w = in.waiting.find(s.id); w != in.waiting.end()) {
+      match += "; waiting outside the map: " + escaped(w->second);
     }
     if (s.excluded) match += "; taken out of the map: " + escaped(s.excluded->reason);
     const Pose& p = s.placed;

@@ -18,7 +18,8 @@ struct ReportInput {
   std::string session_dir;
   std::string generated_at;  // UTC, ISO 8601
   std::vector<StoredScan> scans;
-  std::vector<std::int64_t> waiting;  // scans outside the map, waiting for a match
+  // Scans outside the map, waiting for a match, and why (LiveMap::waiting_reasons).
+  std::map<std::int64_t, std::string> waiting;
   MapAreas areas;
   std::map<std::int64_t, MapAreas> areas_after;  // by scan id
   MissionParams params;

@@ -118,6 +118,7 @@ nlohmann::json scan_json(const LoopStep& s, const LoopStep& first, const LoopSte
           {"joined", pose_json(s.placed_pose)},
           {"placed", pose_json(s.final_pose)},
           {"in_map", s.final_in_map},
+          {"outside", s.final_in_map ? nlohmann::json(nullptr) : nlohmann::json(s.final_outside)},
           {"true", pose_json(true_in_map(first.placed_pose, first.true_pose, s.true_pose))},
           {"placed_error_m", s.final_error_m},
           {"placed_error_deg", s.final_error_deg},

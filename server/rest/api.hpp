@@ -58,6 +58,8 @@ class Api {
   http::Response layer(const std::string& name) const;
   http::Response request_scan(const http::Request& request);
   http::Response post_scan(const http::Request& request);
+  nlohmann::json live_scan_json(const StoredScan& s,
+                                const std::map<std::int64_t, std::string>& waiting) const;
   http::Response list_scans() const;
   http::Response get_scan(const std::string& id) const;
   // DELETE /api/v1/scans/{id} (excluded) and POST /api/v1/scans/{id}/restore.

@@ -57,7 +57,7 @@ Response Api::report() const {
   in.session_dir = session_dir_;
   in.generated_at = iso8601_utc_now();
   in.scans = app_.map.scans();
-  in.waiting = app_.map.waiting();
+  in.waiting = app_.map.waiting_reasons();
   in.areas = app_.map.areas();
   for (const StoredScan& s : in.scans) {
     if (const auto a = app_.map.areas_after(s.id)) in.areas_after[s.id] = *a;

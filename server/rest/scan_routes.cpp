@@ -111,13 +111,18 @@ Response Api::post_scan(const Request& request) {
   }
 }
 
+// A scan of the live map, with why it waits outside the map when it does.
+json Api::live_scan_json(const StoredScan& s,
+                         const std::map<std::int64_t, std::string>& waiting) const {
+  const auto it = waiting.find(s.id);
+  if (it == waiting.end()) return scan_json(s, app_.map.areas_after(s.id), /*in_map=*/true);
+  return scan_json(s, app_.map.areas_after(s.id), /*in_map=*/false, it->second);
+}
+
 Response Api::list_scans() const {
   json list = json::array();
-  const std::vector<std::int64_t> waiting = app_.map.waiting();
-  for (const StoredScan& s : app_.map.scans()) {
-    const bool in_map = !std::binary_search(waiting.begin(), waiting.end(), s.id);
-    list.push_back(scan_json(s, app_.map.areas_after(s.id), in_map));
-  }
+  const std::map<std::int64_t, std::string> waiting = app_.map.waiting_reasons();
+  for (const StoredScan& s : app_.map.scans()) list.push_back(live_scan_json(s, waiting));
   json excluded = json::array();
   for (const StoredScan& s : app_.intake.excluded_scans()) {
     excluded.push_back(scan_json(s, app_.map.areas_after(s.id), false));
@@ -146,11 +151,9 @@ Response Api::set_scan_excluded(const Request& request, const std::string& id, b
 
 Response Api::get_scan(const std::string& id) const {
   const auto n = static_cast<std::int64_t>(rest::path_id(id, "a scan id"));
-  const std::vector<std::int64_t> waiting = app_.map.waiting();
+  const std::map<std::int64_t, std::string> waiting = app_.map.waiting_reasons();
   for (const StoredScan& s : app_.map.scans()) {
-    if (s.id != n) continue;
-    const bool in_map = !std::binary_search(waiting.begin(), waiting.end(), s.id);
-    return Response::json(200, scan_json(s, app_.map.areas_after(s.id), in_map));
+    if (s.id == n) return Response::json(200, live_scan_json(s, waiting));
   }
   for (const StoredScan& s : app_.intake.excluded_scans()) {
     if (s.id == n) return Response::json(200, scan_json(s, app_.map.areas_after(s.id), false));

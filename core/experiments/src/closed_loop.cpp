@@ -187,6 +187,7 @@ void final_errors(const MissionPipeline& mission, LoopResult& result) {
     LoopStep& s = result.steps[k];
     s.final_pose = mission.poses().at(k);
     s.final_in_map = mission.in_map(k);
+    s.final_outside = mission.outside_reason(k);
     if (k == 0) continue;
     const PoseError e = placed_error(first.placed_pose, first.true_pose, s.final_pose, s.true_pose);
     s.final_error_m = e.metres;

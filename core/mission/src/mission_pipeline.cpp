@@ -171,6 +171,13 @@ void MissionPipeline::add(const PointCloud& scan, const Placement& where,
   last_correction_->graph_ms = ms_between(t0, t1) + ms_between(t2, t3);
 }
 
+std::string MissionPipeline::outside_reason(std::size_t i) const {
+  if (in_map(i)) return "";
+  const std::string why = graph_ ? graph_->outside_reason(i) : "";
+  // Anchored but not yet joined: the map takes it with the next update.
+  return why.empty() ? "it joins the map with its next update" : why;
+}
+
 // The map holds the scan where the graph has it, its points moved there on the way in; after
 // every scan already in it, whenever it was taken (map_order()).
 void MissionPipeline::join_map(std::size_t i) {

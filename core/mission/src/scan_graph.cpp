@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "scanplan/geometry/pose_information.hpp"
@@ -232,6 +233,23 @@ void ScanGraph::confirm_by_odometry(std::size_t k) {
       odometry_agrees(p, placed_now(p, *pending_map_[p]), k, graph_.pose(k))) {
     believe_waiting(p);
   }
+}
+
+std::string ScanGraph::outside_reason(std::size_t scan) const {
+  if (anchored_.at(scan)) return "";
+  if (const std::optional<MapCandidate>& c = pending_map_[scan]) {
+    const Pose matched = placed_now(scan, *c);
+    const Pose& odometry = graph_.pose(scan);
+    char off[32];
+    std::snprintf(off, sizeof off, "%.2f m",
+                  std::hypot(matched.x - odometry.x, matched.y - odometry.y));
+    return std::string("its map match puts it ") + off +
+           " from where the odometry does, farther than the odometry usually errs: it waits for "
+           "the robot's next scan, placed by its own match, to agree";
+  }
+  if (!pending_[scan].empty())
+    return "a pairwise match with a scan in the map waits for a second that agrees";
+  return "no match ties it to the map";
 }
 
 void ScanGraph::believe_waiting(std::size_t scan) {

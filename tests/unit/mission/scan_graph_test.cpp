@@ -128,10 +128,16 @@ TEST(ScanGraph, AFarCorrectionIsBelievedWhenTheNextScanAgrees) {
     // The robot drove 150 m on drifting odometry: both reports are 8 m off the same way.
     graph.add(few_points(), placement(at(150, 0, 0), at(150, 8, 0), true), /*tentative=*/true);
     EXPECT_FALSE(graph.anchored(1)) << "one far correction alone is not believed";
+    // Whoever reads why it is not in the map learns what it waits for, and how far off it is.
+    EXPECT_NE(graph.outside_reason(1).find("puts it 8.00 m from where the odometry does"),
+              std::string::npos)
+        << graph.outside_reason(1);
+    EXPECT_EQ(graph.outside_reason(0), "");
     const Pose next_placed = agree ? at(160, 8, 0) : at(160, -8, 0);  // a look-alike 16 m away
     graph.add(few_points(), placement(at(160, 0, 0), next_placed, true), /*tentative=*/true);
     EXPECT_EQ(graph.anchored(1), agree);
     EXPECT_EQ(graph.anchored(2), agree);
+    EXPECT_EQ(graph.outside_reason(1).empty(), agree) << graph.outside_reason(1);
     if (agree) {
       EXPECT_NEAR(graph.poses()[1].y, 8, 0.01);
       EXPECT_EQ(graph.edge_origin(graph.graph().edges().size() - 1), "map-confirmed");
@@ -162,6 +168,7 @@ TEST(ScanGraph, AWaitingScanIsBelievedAcrossARefusedScan) {
     graph.add(few_points(), placement(at(0, 0, 0), at(0, 0, 0), false));
     graph.add(few_points(), placement(at(150, 0, 0), at(150, 8, 0), true), /*tentative=*/true);
     graph.add(few_points(), placement(at(160, 0, 0), at(160, 0, 0), false));  // refused
+    EXPECT_EQ(graph.outside_reason(2), "no match ties it to the map");
     graph.add(few_points(), placement(at(170, 0, 0), at(170, 8 + off, 0), true));
     EXPECT_TRUE(graph.anchored(3));
     EXPECT_EQ(graph.anchored(1), off < 1) << off << " m";

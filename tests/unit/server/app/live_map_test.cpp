@@ -64,6 +64,11 @@ TEST_F(LiveMapGraphTest, AScanTiedInLaterJoinsTheMapWhereItBelongs) {
   const LiveMap::Added second = add(2, at(-5, -9, 0), at(-3, -7, 0), /*match=*/false);
   EXPECT_FALSE(second.in_map);
   EXPECT_EQ(map_.waiting(), std::vector<std::int64_t>{2});
+  // The operator reads why (GET /api/v1/scans `outside`): its pairwise match with the first
+  // waits for a second that agrees.
+  const std::map<std::int64_t, std::string> why = map_.waiting_reasons();
+  ASSERT_EQ(why.size(), 1u);
+  EXPECT_EQ(why.at(2), "a pairwise match with a scan in the map waits for a second that agrees");
   EXPECT_EQ(map_.point_count(), points_one) << "a waiting scan's points are not in the map";
   EXPECT_FALSE(map_.encoded_range(1, 2).draco) << "nor in what a page fetches of the map";
   ASSERT_EQ(second.corrected.poses.size(), 1u) << "its pose is recorded as waiting";
@@ -74,6 +79,7 @@ TEST_F(LiveMapGraphTest, AScanTiedInLaterJoinsTheMapWhereItBelongs) {
   const LiveMap::Added third = add(3, at(-12, 4, 30), at(-12, 4, 30));
   EXPECT_TRUE(third.in_map);
   EXPECT_TRUE(map_.waiting().empty());
+  EXPECT_TRUE(map_.waiting_reasons().empty());
   EXPECT_EQ(third.corrected.joined, std::vector<std::int64_t>{2});
   EXPECT_FALSE(third.plans.empty()) << "planned on the corrected map";
   const auto scans = map_.scans();

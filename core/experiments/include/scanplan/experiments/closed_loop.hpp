@@ -53,6 +53,7 @@ struct LoopStep {
   // Whether the map held the scan when the mission ended (with the graph, only scans tied in by
   // a believed match are in it; the others wait, at the graph's estimate).
   bool final_in_map = true;
+  std::string final_outside;  // why not in the map at the end (MissionPipeline::outside_reason)
   // The graph's work after this scan: pairs matched of those tried, the solve, and how far it
   // moved the scans already in the map.
   std::size_t pairs_tried = 0, pairs_matched = 0;

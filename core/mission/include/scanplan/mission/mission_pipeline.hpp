@@ -7,6 +7,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "scanplan/geometry/point_cloud.hpp"
@@ -148,6 +149,8 @@ class MissionPipeline {
   // scans are, so that one left metres off makes no phantom walls and steps for the planner;
   // it joins once a match ties it in.
   bool in_map(std::size_t i) const { return in_map_.at(i) != 0; }
+  // Why the i-th scan is not in the map (ScanGraph::outside_reason); empty when it is.
+  std::string outside_reason(std::size_t i) const;
   // What the graph did after the latest scan; nothing with the graph off.
   const std::optional<MapCorrection>& last_correction() const { return last_correction_; }
   const ScanGraph* graph() const { return graph_ ? &*graph_ : nullptr; }

@@ -140,6 +140,10 @@ class ScanGraph {
   // came or later), or one two agreeing pairwise matches with anchored scans placed; and the
   // edge that did it not set aside as an outlier.
   bool anchored(std::size_t scan) const { return anchored_.at(scan) != 0; }
+  // Why a scan is not anchored, for whoever reads why it is not in the map (empty when it is
+  // anchored): a far map match waiting for the robot's next scan to agree (and how far it lies
+  // from where the odometry puts the scan), pairwise matches waiting for a second, or none.
+  std::string outside_reason(std::size_t scan) const;
   // The latest scan of a robot, if any.
   std::optional<std::size_t> last_of(const std::string& track) const;
   // The latest scan of a robot that is anchored, if any.
