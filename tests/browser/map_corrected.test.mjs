@@ -46,6 +46,11 @@ test('the page draws the map as the graph has it and says when it was corrected'
       return a.scans.length === 4 && a.pending === 0 ? a.scans : undefined;
     }, 120000);
     const inMap = scans.filter((s) => s.in_map).map((s) => s.id);
+    // A scan outside the map says why; one in it says nothing.
+    for (const s of scans) {
+      if (s.in_map) assert.equal(s.outside, null, `scan ${s.id}`);
+      else assert.ok(typeof s.outside === 'string' && s.outside.length > 0, `scan ${s.id}: ${s.outside}`);
+    }
     await stack.waitFor('the last scan\'s events', async () => settled || undefined, 30000);
     assert.ok(corrections.length >= 1, 'the graph corrected the map');
     // The page had every correction the server made, and then holds each scan in the map where
@@ -55,6 +60,11 @@ test('the page draws the map as the graph has it and says when it was corrected'
       corrections.length);
     await waitForData(page, `the ${inMap.length} scans in the map drawn where they are, and no other`,
       (n) => document.body.dataset.chunks === String(n) && document.body.dataset.mapCurrent === 'true', inMap.length, 60000);
+    // The page's match history tells the operator why a scan waits outside the map.
+    const history = await page.locator('#match-result').getAttribute('title');
+    for (const s of scans.filter((x) => !x.in_map)) {
+      assert.ok(history.includes(`scan ${s.id}: waiting outside the map (not drawn): ${s.outside}`), history);
+    }
     const said = await page.locator('#log li', { hasText: 'map corrected' }).first().textContent();
     assert.match(said, /map corrected: scans? [0-9]/);
     // The chunks came over the WebSocket as the scans joined; a scan the graph moved or tied in

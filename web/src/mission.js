@@ -124,7 +124,13 @@ export class MissionPanel {
       const p = s.placed;
       if (!e || !p) continue;
       const dyaw = ((((p.yaw_deg - e.yaw_deg) % 360) + 540) % 360) - 180;
-      this.corrections.set(s.id, { shift: Math.hypot(p.x - e.x, p.y - e.y), dz: p.z - e.z, dyaw, waiting: s.in_map === false });
+      this.corrections.set(s.id, {
+        shift: Math.hypot(p.x - e.x, p.y - e.y),
+        dz: p.z - e.z,
+        dyaw,
+        waiting: s.in_map === false,
+        outside: s.outside || '',
+      });
     }
     this.render();
   }
@@ -134,14 +140,17 @@ export class MissionPanel {
     const ids = [...new Set([...this.corrections.keys(), ...this.matches.keys()])].sort((a, b) => a - b);
     return ids.map((id) => {
       const m = this.matches.get(id);
-      if (this.corrections.get(id)?.waiting) {
-        return `scan ${id}: waiting outside the map until a match ties it in (not drawn)`;
+      const c = this.corrections.get(id);
+      if (c?.waiting) {
+        // The server says why (GET /api/v1/scans `outside`).
+        return c.outside
+          ? `scan ${id}: waiting outside the map (not drawn): ${c.outside}`
+          : `scan ${id}: waiting outside the map until a match ties it in (not drawn)`;
       }
       if (m) {
-        const c = m.correction || {};
-        return `scan ${id}: score ${f2(m.score)}, RMSE ${f2(m.rmse)} m, shift ${f2(Math.hypot(c.x || 0, c.y || 0))} m / ${f2(c.yaw_deg)}°, ${m.applied ? 'applied' : 'not applied'}`;
+        const d = m.correction || {};
+        return `scan ${id}: score ${f2(m.score)}, RMSE ${f2(m.rmse)} m, shift ${f2(Math.hypot(d.x || 0, d.y || 0))} m / ${f2(d.yaw_deg)}°, ${m.applied ? 'applied' : 'not applied'}`;
       }
-      const c = this.corrections.get(id);
       if (id === ids[0] && c.shift === 0 && c.dyaw === 0) return `scan ${id}: the reference`;
       return `scan ${id}: placed ${f2(c.shift)} m / ${f2(c.dyaw)}° from its reported pose`;
     });
