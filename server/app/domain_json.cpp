@@ -235,10 +235,12 @@ json match_done_json(std::int64_t scan, const Pose& e, const MapMatch& m) {
             {"yaw_deg", rad2deg(std::remainder(p.yaw - e.yaw, 2 * M_PI))}}}};
 }
 
-json map_updated_json(const StoredScan& scan, const MapAreas& a, bool in_map, json stages_ms) {
+json map_updated_json(const StoredScan& scan, const MapAreas& a, bool in_map,
+                      const std::string& outside, json stages_ms) {
   return {{"scan", scan.id},
           {"points", scan.points},
           {"in_map", in_map},
+          {"outside", in_map ? json(nullptr) : json(outside)},
           {"completed_m2", a.completed_m2},
           {"low_resolution_m2", a.low_resolution_m2},
           {"unscanned_m2", a.unscanned_m2},

@@ -51,9 +51,10 @@ nlohmann::json decision_json(const SessionEvent& e);
 
 // Event payloads (docs/api.md "Events").
 nlohmann::json match_done_json(std::int64_t scan, const Pose& estimated, const MapMatch& m);
-// `stages_ms`: where the scan's way into the map went (ScanIntake::process).
+// `stages_ms`: where the scan's way into the map went (ScanIntake::process); `outside`: why it
+// waits outside the map when it does (LiveMap::Added).
 nlohmann::json map_updated_json(const StoredScan& scan, const MapAreas& a, bool in_map,
-                                nlohmann::json stages_ms);
+                                const std::string& outside, nlohmann::json stages_ms);
 // The pose graph moved scans, or tied them into the map or set them outside it (revision: the
 // session's pose revision that records it; 0 when it could not be recorded).
 nlohmann::json map_corrected_json(const MapCorrected& c, std::int64_t revision);

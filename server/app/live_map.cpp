@@ -166,6 +166,7 @@ LiveMap::Added LiveMap::add(const StoredScan& scan, const PointCloud& cloud) {
   }
   out.corrected = f.corrected;
   out.in_map = f.in_map.back() != 0;
+  out.outside = f.outside.back();
   out.plans = refresh_derived([&] { commit(std::move(f)); }, /*scan_joined=*/true, &out.times);
   encode_wanted_.notify_one();
   // Outside mutex_ so readers are not held up, inside encode_mutex_ so maps and plans go out in

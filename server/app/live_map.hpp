@@ -122,7 +122,8 @@ class LiveMap {
   struct Added {
     std::vector<PlanRecord> plans;
     MapCorrected corrected;
-    bool in_map = true;  // the new scan joined the map (with the graph, it may wait outside)
+    bool in_map = true;   // the new scan joined the map (with the graph, it may wait outside)
+    std::string outside;  // why it waits outside (MissionPipeline::outside_reason), else empty
     AddTimes times;
   };
   Added add(const StoredScan& scan, const PointCloud& cloud);

@@ -193,7 +193,8 @@ void ScanIntake::process(const StoredScan& scan, const PointCloud& cloud, bool r
   nlohmann::json stages = {
       {"graph", t.graph}, {"map", t.map}, {"thin", t.thin}, {"plan", t.plan}, {"layers", t.layers}};
   if (match_ms) stages["match"] = *match_ms;
-  events_.publish("map_updated", map_updated_json(scan, a, added.in_map, std::move(stages)));
+  events_.publish("map_updated",
+                  map_updated_json(scan, a, added.in_map, added.outside, std::move(stages)));
 }
 
 void ScanIntake::publish_plans(std::vector<PlanRecord> plans, const std::string& first) {

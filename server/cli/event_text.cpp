@@ -196,9 +196,14 @@ std::string describe_event(const json& e) {
   if (type == "map_corrected") return map_corrected(e);
   if (type == "map_updated") {
     const bool waiting = !e.value("in_map", true);
+    // Why it waits, when the server says (older servers do not).
+    const std::string why = e.contains("outside") && e.at("outside").is_string()
+                                ? e.at("outside").get<std::string>()
+                                : "";
     return "scan " + str(e, "scan") +
-           (waiting ? " waits outside the map until a match ties it in: completed "
-                    : " is in the map: completed ") +
+           (!waiting      ? " is in the map: completed "
+            : why.empty() ? " waits outside the map until a match ties it in: completed "
+                          : " waits outside the map (" + why + "): completed ") +
            fixed(num(e, "completed_m2"), 0) + " m2, low-res " +
            fixed(num(e, "low_resolution_m2"), 0) + " m2, unscanned " +
            fixed(num(e, "unscanned_m2"), 0) + " m2, movable " + fixed(num(e, "movable_m2"), 0) +

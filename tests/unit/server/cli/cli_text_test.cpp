@@ -239,6 +239,14 @@ TEST(EventText, DescribesEachEventType) {
                  "low_resolution_m2":2,"unscanned_m2":3,"movable_m2":4})"),
             "scan 4 waits outside the map until a match ties it in: completed 1 m2, low-res 2 m2, "
             "unscanned 3 m2, movable 4 m2");
+  EXPECT_EQ(d(R"({"type":"map_updated","scan":4,"points":10,"in_map":false,
+                 "outside":"no match ties it to the map","completed_m2":1,
+                 "low_resolution_m2":2,"unscanned_m2":3,"movable_m2":4})"),
+            "scan 4 waits outside the map (no match ties it to the map): completed 1 m2, low-res "
+            "2 m2, unscanned 3 m2, movable 4 m2");
+  EXPECT_EQ(d(R"({"type":"map_updated","scan":4,"points":10,"in_map":true,"outside":null,
+                 "completed_m2":1,"low_resolution_m2":2,"unscanned_m2":3,"movable_m2":4})"),
+            "scan 4 is in the map: completed 1 m2, low-res 2 m2, unscanned 3 m2, movable 4 m2");
   EXPECT_EQ(d(R"({"type":"something_new","at":"t","value":1})"), R"({"value":1})")
       << "an unknown event is shown, not hidden";
 }
