@@ -526,11 +526,8 @@ std::vector<StoredScan> LiveMap::scans() const {
 }
 
 std::vector<std::int64_t> LiveMap::waiting() const {
-  std::lock_guard lock(mutex_);
   std::vector<std::int64_t> out;
-  for (std::size_t i = 0; i < scans_.size(); ++i) {
-    if (!in_map_[i]) out.push_back(scans_[i].id);
-  }
+  for (const auto& [id, why] : waiting_reasons()) out.push_back(id);
   return out;
 }
 

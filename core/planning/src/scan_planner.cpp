@@ -414,21 +414,18 @@ ClimbStarts screened_starts(SiteGains& gain, SiteGains& screen, const Sites& sit
     chosen.push_back(order[k].site);
   }
   if (&screen == &gain) {
-    out.screened = std::move(looked);
-    out.sites = std::move(chosen);
-    out.score = scorer_for(best_f_of(out.screened));
-    for (Scored& x : out.screened) x.score = out.score(x.site, x.gain);
-    return out;
+    out.screened = std::move(looked);  // already the full fan's
+  } else {
+    out.evaluations = looked.size();
+    const auto most_f =
+        std::max_element(looked.begin(), looked.end(), [](const Scored& a, const Scored& b) {
+          return a.gain.f != b.gain.f ? a.gain.f < b.gain.f : a.site > b.site;
+        });
+    std::vector<std::int32_t> again = chosen;
+    if (std::find(again.begin(), again.end(), most_f->site) == again.end())
+      again.push_back(most_f->site);
+    out.screened = evaluate_sites(gain, again, threads);
   }
-  out.evaluations = looked.size();
-  const auto most_f =
-      std::max_element(looked.begin(), looked.end(), [](const Scored& a, const Scored& b) {
-        return a.gain.f != b.gain.f ? a.gain.f < b.gain.f : a.site > b.site;
-      });
-  std::vector<std::int32_t> again = chosen;
-  if (std::find(again.begin(), again.end(), most_f->site) == again.end())
-    again.push_back(most_f->site);
-  out.screened = evaluate_sites(gain, again, threads);
   out.score = scorer_for(best_f_of(out.screened));
   for (Scored& x : out.screened) x.score = out.score(x.site, x.gain);
   out.sites = std::move(chosen);
