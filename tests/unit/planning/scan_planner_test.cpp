@@ -247,7 +247,7 @@ TEST_F(WallYard, TheSparseScreeningOnlyChoosesWhereToClimb) {
     const Plan same_fan = plan_next_scan(input(), cfg);
     EXPECT_GT(plan.evaluations, 500u) << policy_name(p);
     EXPECT_NEAR(static_cast<double>(plan.evaluations), static_cast<double>(same_fan.evaluations),
-                0.2 * same_fan.evaluations)
+                0.2 * static_cast<double>(same_fan.evaluations))
         << policy_name(p);
   }
 }
