@@ -101,6 +101,9 @@ json candidate_json(const CandidateRecord& r, const std::string& robot, std::uin
                       {"pose_fixing", c.registrability->pose_fixing},
                       {"reach", c.registrability->reach},
                       {"factor", c.registrability->factor}};
+    if (const auto& v = c.registrability->predicted_constraint) {
+      registrability["predicted_constraint"] = *v;
+    }
   }
   return {{"id", r.id},
           {"robot", robot},

@@ -27,6 +27,8 @@ struct SimulateArgs {
   std::string odometry;  // empty: the world file's
   std::string graph = "on";
   RegistrabilityConfig forecast;
+  std::string view_check = "on";
+  ViewCheckConfig view;
 };
 
 nlohmann::json optional_json(const auto& v) {
@@ -51,6 +53,8 @@ ClosedLoopConfig config_of(const SimulateArgs& a) {
   if (a.graph == "off") config.graph.reset();
   config.planner.registrability = a.forecast;
   config.planner.registrability.enabled = a.registrability == "on";
+  config.view_check = a.view;
+  config.view_check.enabled = a.view_check == "on";
   return config;
 }
 
@@ -84,10 +88,12 @@ nlohmann::json forecast_json(const LoopStep* previous) {
   const std::optional<Registrability>& r =
       previous->candidates.at(*previous->chosen).registrability;
   if (!r) return nullptr;
-  return {{"overlap_share", r->overlap_share},
-          {"pose_fixing", r->pose_fixing},
-          {"reach", r->reach},
-          {"factor", r->factor}};
+  nlohmann::json out = {{"overlap_share", r->overlap_share},
+                        {"pose_fixing", r->pose_fixing},
+                        {"reach", r->reach},
+                        {"factor", r->factor}};
+  if (r->predicted_constraint) out["predicted_constraint"] = *r->predicted_constraint;
+  return out;
 }
 
 // One scan as summary.json lists it (DESIGN.md "CLI"): where the robot said it was, where the
@@ -234,6 +240,7 @@ nlohmann::json summary_of(const SimulateArgs& a, const World& world, const Close
           {"graph", a.graph},
           {"odometry", odometry_model_name(world.pose_noise.model)},
           {"registrability", a.registrability},
+          {"view_check", a.view_check},
           {"scans", scans},
           {"detected_m2", last.detected_m2},
           {"completed_m2", last.completed_m2},
@@ -333,6 +340,16 @@ void add_simulate_command(CLI::App& app) {
       ->check(CLI::Range(0.001, 1.0));
   cmd->add_option("--min-pose-fixing", args->forecast.min_pose_fixing,
                   "registrability: the pose fixing below which a candidate loses score")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--view-check", args->view_check,
+                  "registrability: the best candidates checked once more against the map's own "
+                  "points a scan there would see (on|off)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"on", "off"}));
+  cmd->add_option("--view-min-constraint", args->view.min_constraint,
+                  "view check: the predicted weakest constraint below which a candidate loses "
+                  "score")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   cmd->add_option("--out", args->out,

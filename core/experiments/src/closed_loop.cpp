@@ -229,8 +229,13 @@ LoopResult run_closed_loop(
   const WorldTraversability trav(world, caster);
   Pose truth = trav.standing_pose(world.start.x, world.start.y, world.start.z, world.start.yaw);
 
-  MissionConfig mission_config{config.pipeline, config.planner, config.matching, world.pose_noise,
-                               config.graph};
+  MissionConfig mission_config;
+  mission_config.mapping = config.pipeline;
+  mission_config.planner = config.planner;
+  mission_config.matching = config.matching;
+  mission_config.pose_noise = world.pose_noise;
+  mission_config.graph = config.graph;
+  mission_config.view_check = config.view_check;
   mission_config.mapping.sensor_height_m = world.scanner.mount_height_m;
   MissionPipeline mission(mission_config);
   const MappingPipeline& pipeline = mission.mapping();

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "scanplan/mission/ahead_of_turn.hpp"
+#include "scanplan/registration/alignment_quality.hpp"
 
 namespace scanplan {
 namespace {
@@ -413,8 +414,12 @@ std::vector<FleetPlan> MissionPipeline::plan(const std::vector<FleetRobot>& robo
     r.drift = drift_of(r.id);
     r.memo = memos_->of(r.id);
   }
-  return plan_fleet(mapping_.map(), *mapping_.target(), mapping_.scan_points(), drifting,
-                    std::move(claimed), planner_config(), anchored_map());
+  std::vector<FleetPlan> plans =
+      plan_fleet(mapping_.map(), *mapping_.target(), mapping_.scan_points(), drifting,
+                 std::move(claimed), planner_config(), anchored_map());
+  // Each robot's own ranking; the fleet's order of decision stays the forecast's.
+  for (FleetPlan& p : plans) check_plan(p.plan);
+  return plans;
 }
 
 std::optional<DriveDrift> MissionPipeline::drift_of(const std::string& track) const {
@@ -463,7 +468,42 @@ Plan MissionPipeline::plan_from(const Eigen::Vector3d& robot, std::uint64_t seed
   const std::optional<DriveDrift> drift = drift_of(track);
   if (drift) in.drift = &*drift;
   in.memo = memos_->of(track);
-  return plan_next_scan(in, planner);
+  Plan plan = plan_next_scan(in, planner);
+  check_plan(plan);
+  return plan;
+}
+
+void MissionPipeline::check_plan(Plan& plan) const {
+  if (!config_.matching || !config_.planner.registrability.enabled) return;
+  const auto t0 = Clock::now();
+  check_views(
+      plan, [this](const Candidate& c) { return predicted_constraint(c); }, config_.view_check,
+      config_.planner.registrability.floor_share);
+  plan.plan_ms += ms_between(t0, Clock::now());
+}
+
+// The anchored scans' points a match there would be made against (match_input), those a scanner
+// there sees, judged in the levelled frame at the candidate as match_to_map judges a match.
+double MissionPipeline::predicted_constraint(const Candidate& candidate) const {
+  const MapMatchConfig& m = *config_.matching;
+  const Eigen::Vector3d& at = candidate.position;
+  const double voxel = m.registration.voxel_m;
+  const PointCloud map = points_of(match_sources(at.x(), at.y(), m.target_radius_m), at.x(),
+                                   at.y(), m.target_radius_m, nullptr, voxel);
+  const Eigen::Vector3f floor = at.cast<float>();
+  const Eigen::Vector3f eye = floor + scanner_view().origins.front();
+  const PointCloud seen =
+      visible_points(map, eye, voxel, m.target_radius_m, config_.view_check);
+  if (seen.empty()) return 0;
+  PointCloud target, source;
+  target.points.reserve(map.size());
+  for (const Eigen::Vector3f& p : map.points) target.points.push_back(p - floor);
+  source.points.reserve(seen.size());
+  for (const Eigen::Vector3f& p : seen.points) source.points.push_back(p - floor);
+  const RegistrationConfig& r = m.registration;
+  return evaluate_alignment(target, source, Eigen::Isometry3d::Identity(), r.dof,
+                            r.score_max_distance_m, r.inlier_distance_m)
+      .weakest_constraint;
 }
 
 // Too rough to place a scan by themselves: as sensors_place judges it.

@@ -367,6 +367,37 @@ TEST_F(MissionPipelineTest, PlansTheNextScanInsideTheMovableRegion) {
   EXPECT_GT((plans[0].plan.ranked[0].position - plans[1].plan.ranked[0].position).norm(), 1.0);
 }
 
+TEST_F(MissionPipelineTest, TheBestCandidateIsCheckedAgainstWhatAScanThereWouldSee) {
+  MissionConfig c = config();
+  MissionPipeline mission(c);
+  mission.set_target(world_->target_region());
+  mission.add(scan_at(at(-15, -8, 0), 1), {at(-15, -8, 0), at(-15, -8, 0)});
+  const Plan plan = mission.plan_from({-15, -8, 0}, 1);
+  ASSERT_FALSE(plan.ranked.empty());
+  ASSERT_TRUE(plan.ranked[0].registrability);
+  const auto checked = plan.ranked[0].registrability->predicted_constraint;
+  ASSERT_TRUE(checked) << "the best candidate is always checked";
+  std::size_t failed = 0;
+  for (const Candidate& k : plan.ranked) {
+    const auto& v = k.registrability->predicted_constraint;
+    if (v && *v < c.view_check.min_constraint) ++failed;
+  }
+  // Either the best passed, or every candidate checked failed.
+  if (*checked < c.view_check.min_constraint) {
+    EXPECT_EQ(failed, c.view_check.candidates);
+  }
+  // The yard's buildings around the first scan fix a scan near it firmly.
+  EXPECT_GT(*checked, 0.0);
+
+  c.view_check.enabled = false;
+  MissionPipeline unchecked(c);
+  unchecked.set_target(world_->target_region());
+  unchecked.add(scan_at(at(-15, -8, 0), 1), {at(-15, -8, 0), at(-15, -8, 0)});
+  for (const Candidate& k : unchecked.plan_from({-15, -8, 0}, 1).ranked) {
+    EXPECT_FALSE(k.registrability->predicted_constraint);
+  }
+}
+
 TEST_F(MissionPipelineTest, PointsNearKeepsTheMapWithinTheRadius) {
   MissionPipeline mission(config());
   mission.add(scan_at(at(-15, -8, 0), 1), {at(-15, -8, 0), at(-15, -8, 0)});

@@ -24,6 +24,8 @@ struct ClosedLoopConfig {
   // The pose graph over the scans (with matching on); nothing: each scan stays where its
   // match put it.
   std::optional<ScanGraphConfig> graph = ScanGraphConfig{};
+  // The best candidates checked against the map's points (MissionConfig::view_check).
+  ViewCheckConfig view_check;
 };
 
 // One scan of the loop and the decision taken after it.

@@ -16,6 +16,7 @@
 #include "scanplan/mission/placement.hpp"
 #include "scanplan/mission/scan_graph.hpp"
 #include "scanplan/mission/sensor_frame.hpp"
+#include "scanplan/mission/view_check.hpp"
 #include "scanplan/planning/fleet_planner.hpp"
 #include "scanplan/planning/scan_planner.hpp"
 #include "scanplan/registration/map_matcher.hpp"
@@ -46,6 +47,9 @@ struct MissionConfig {
   // anew for 2 cm moves; issue 19).
   double remap_m = 0.05;
   double remap_deg = 0.1;
+  // The best candidates of each plan checked against the anchored map's points (issue 15);
+  // only while matching is on.
+  ViewCheckConfig view_check;
 };
 
 // How the map changed when the graph moved scans after the latest one joined.
@@ -236,6 +240,10 @@ class MissionPipeline {
   PointCloud points_of(const std::vector<std::size_t>& scans, double x, double y, double radius_m,
                        Viewpoints* views, double thinned_to_m = 0) const;
   void set_cloud(std::size_t i, std::shared_ptr<const PointCloud> in_map);
+  // The weakest constraint a scan at `candidate` is predicted to meet (ViewCheckConfig), and
+  // the plan's best candidates checked by it.
+  double predicted_constraint(const Candidate& candidate) const;
+  void check_plan(Plan& plan) const;
   MapCorrection correction(const GraphUpdate& update, const std::vector<Pose>& before) const;
   void replace();
 };

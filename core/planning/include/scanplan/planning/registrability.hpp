@@ -114,6 +114,10 @@ struct Registrability {
   double reach = 1;
   // The share of its score the candidate keeps (1: registrable).
   double factor = 1;
+  // The weakest constraint the map's own points a scan there is predicted to see put on its
+  // pose, as the matcher's sanity check judges it (ViewCheckConfig, in the mission pipeline);
+  // nothing where not checked. A failed check is counted in `factor`.
+  std::optional<double> predicted_constraint;
 };
 
 // The anchored map (the scans the matcher trusts; MissionPipeline) rasterised on the planner's
