@@ -24,7 +24,8 @@ class RangeImage {
     double az, el;
   };
   static Direction direction_of(const Eigen::Vector3f& d) {
-    return {std::atan2(d.y(), d.x()) + M_PI, std::atan2(d.z(), std::hypot(d.x(), d.y())) + M_PI / 2};
+    return {std::atan2(d.y(), d.x()) + M_PI,
+            std::atan2(d.z(), std::hypot(d.x(), d.y())) + M_PI / 2};
   }
   std::size_t bin_of(Direction a) const { return offset(col(a.az), row(a.el)); }
   std::size_t size() const {
@@ -47,9 +48,7 @@ class RangeImage {
   float nearest(std::size_t bin) const { return range_[bin]; }
 
  private:
-  int col(double az) const {
-    return std::clamp(static_cast<int>(az * per_rad_), 0, cols_ - 1);
-  }
+  int col(double az) const { return std::clamp(static_cast<int>(az * per_rad_), 0, cols_ - 1); }
   int row(double el) const {
     return std::clamp(static_cast<int>(std::floor(el * per_rad_)), 0, rows_ - 1);
   }

@@ -146,7 +146,8 @@ TEST(CheckViews, ACandidateTheCheckFailsFallsBehindAndTheNextIsChecked) {
 TEST(CheckViews, AFailedCandidateStillTheBestStaysFirst) {
   Plan plan;
   plan.ranked = {candidate(1, 100), candidate(2, 1)};
-  check_views(plan, [](const Candidate&) { return 0.024; }, {}, 0.05);
+  check_views(
+      plan, [](const Candidate&) { return 0.024; }, {}, 0.05);
   // (0.024 / 0.03)² = 0.64 of 100 still beats 1; checked once.
   EXPECT_EQ(plan.ranked[0].position.x(), 1);
   EXPECT_NEAR(plan.ranked[0].score, 64, 1e-9);
@@ -156,7 +157,8 @@ TEST(CheckViews, AFailedCandidateStillTheBestStaysFirst) {
 TEST(CheckViews, ANegativeScoreFallsToo) {
   Plan plan;
   plan.ranked = {candidate(1, -2), candidate(2, -3)};
-  check_views(plan, [](const Candidate& c) { return c.position.x() == 1 ? 0.0 : 1.0; }, {}, 0.05);
+  check_views(
+      plan, [](const Candidate& c) { return c.position.x() == 1 ? 0.0 : 1.0; }, {}, 0.05);
   EXPECT_EQ(plan.ranked[0].position.x(), 2);
   EXPECT_LT(plan.ranked[1].score, -3);
 }
