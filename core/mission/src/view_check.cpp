@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace scanplan {
@@ -66,6 +68,10 @@ class RangeImage {
 
 PointCloud visible_points(const PointCloud& map, const Eigen::Vector3f& eye, double voxel_m,
                           double max_range_m, const ViewCheckConfig& config) {
+  if (!(config.bin_deg > 0 && config.bin_deg <= 90)) {
+    throw std::invalid_argument("view check: bin_deg must be within (0, 90] degrees, not " +
+                                std::to_string(config.bin_deg));
+  }
   RangeImage image(config.bin_deg);
   const auto max_range = static_cast<float>(max_range_m);
   // The scanner's own body and what it stands on right below it: no surface to match.

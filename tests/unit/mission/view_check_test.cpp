@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
 
 #include "scanplan/registration/alignment_quality.hpp"
 
@@ -100,6 +101,16 @@ double predicted(const PointCloud& map) {
       .weakest_constraint;
 }
 
+TEST(VisiblePoints, RefusesBinsThatAreNoAngle) {
+  PointCloud map;
+  add_ground(map, 5);
+  ViewCheckConfig config;
+  for (const double bad : {0.0, -1.0, std::nan(""), 200.0}) {
+    config.bin_deg = bad;
+    EXPECT_THROW(visible_points(map, {0, 0, 1.5f}, kVoxel, 60, config), std::invalid_argument);
+  }
+}
+
 TEST(VisiblePoints, OneLongFacadeFixesThePoseWeaklyACornerFirmly) {
   PointCloud facade;
   add_ground(facade, 30);
@@ -109,6 +120,13 @@ TEST(VisiblePoints, OneLongFacadeFixesThePoseWeaklyACornerFirmly) {
   const double weak = predicted(facade), firm = predicted(corner);
   EXPECT_LT(weak, ViewCheckConfig{}.min_constraint);
   EXPECT_GT(firm, ViewCheckConfig{}.min_constraint);
+}
+
+// The tests' own threshold, so that they read whatever the default.
+ViewCheckConfig at_003() {
+  ViewCheckConfig c;
+  c.min_constraint = 0.03;
+  return c;
 }
 
 Candidate candidate(double x, double score) {
@@ -129,7 +147,7 @@ TEST(CheckViews, ACandidateTheCheckFailsFallsBehindAndTheNextIsChecked) {
         ++calls;
         return c.position.x() == 1 ? 0.006 : 0.05;
       },
-      {}, 0.05);
+      at_003(), 0.05);
   EXPECT_EQ(calls, 2);
   ASSERT_EQ(plan.ranked.size(), 3u);
   EXPECT_EQ(plan.ranked[0].position.x(), 2);
@@ -147,7 +165,7 @@ TEST(CheckViews, AFailedCandidateStillTheBestStaysFirst) {
   Plan plan;
   plan.ranked = {candidate(1, 100), candidate(2, 1)};
   check_views(
-      plan, [](const Candidate&) { return 0.024; }, {}, 0.05);
+      plan, [](const Candidate&) { return 0.024; }, at_003(), 0.05);
   // (0.024 / 0.03)² = 0.64 of 100 still beats 1; checked once.
   EXPECT_EQ(plan.ranked[0].position.x(), 1);
   EXPECT_NEAR(plan.ranked[0].score, 64, 1e-9);

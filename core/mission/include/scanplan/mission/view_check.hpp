@@ -44,6 +44,7 @@ struct ViewCheckConfig {
 // a voxel and hides what lies behind the bins its voxel spans, so that a near wall the thinning
 // left holes in still hides what is behind it; far off, where a bin spans several voxels (the
 // ground at a grazing angle), only the nearest is returned, as sparse as the scan will be.
+// Throws std::invalid_argument for bins that are no angle.
 PointCloud visible_points(const PointCloud& map, const Eigen::Vector3f& eye, double voxel_m,
                           double max_range_m, const ViewCheckConfig& config);
 
