@@ -182,29 +182,22 @@ TEST(CheckViews, ANegativeScoreFallsToo) {
 }
 
 TEST(CheckViews, StopsAfterTheConfiguredCandidatesAndWhenOff) {
+  int calls = 0;
+  // Every candidate fails the check.
+  const auto fails = [&calls](const Candidate&) {
+    ++calls;
+    return 0.0;
+  };
   Plan plan;
   for (int i = 0; i < 8; ++i) plan.ranked.push_back(candidate(i, 10 - i));
-  int calls = 0;
   ViewCheckConfig config;
   config.candidates = 3;
-  check_views(
-      plan,
-      [&](const Candidate&) {
-        ++calls;
-        return 0.0;
-      },
-      config, 0.05);
+  check_views(plan, fails, config, 0.05);
   EXPECT_EQ(calls, 3);
   config.enabled = false;
   Plan untouched;
   untouched.ranked = {candidate(1, 10), candidate(2, 8)};
-  check_views(
-      untouched,
-      [&](const Candidate&) {
-        ++calls;
-        return 0.0;
-      },
-      config, 0.05);
+  check_views(untouched, fails, config, 0.05);
   EXPECT_EQ(calls, 3);
   EXPECT_EQ(untouched.ranked[0].position.x(), 1);
   EXPECT_FALSE(untouched.ranked[0].registrability->predicted_constraint);
@@ -212,13 +205,7 @@ TEST(CheckViews, StopsAfterTheConfiguredCandidatesAndWhenOff) {
   Plan unforecast;
   unforecast.ranked = {candidate(1, 10)};
   unforecast.ranked[0].registrability.reset();
-  check_views(
-      unforecast,
-      [&](const Candidate&) {
-        ++calls;
-        return 0.0;
-      },
-      {}, 0.05);
+  check_views(unforecast, fails, {}, 0.05);
   EXPECT_EQ(calls, 3);
 }
 
