@@ -49,10 +49,11 @@ PointCloud visible_points(const PointCloud& map, const Eigen::Vector3f& eye, dou
                           double max_range_m, const ViewCheckConfig& config);
 
 // Checks the best candidates of `plan` in rank order with `constraint` (a candidate's predicted
-// weakest constraint; called for those whose forecast let them keep their score) until the best
-// one passes or `config.candidates` were checked; a candidate that fails keeps the share of its
-// score ViewCheckConfig::min_constraint says, and the plan is ranked again. Records each
-// check in the candidate's Registrability::predicted_constraint.
+// weakest constraint; only candidates with a forecast, Candidate::registrability, are checked)
+// until the best one passes or `config.candidates` were checked; a candidate that fails keeps
+// the share of its score ViewCheckConfig::min_constraint says, on top of its forecast's, and the
+// plan is ranked again. Records each check in the candidate's
+// Registrability::predicted_constraint.
 void check_views(Plan& plan, const std::function<double(const Candidate&)>& constraint,
                  const ViewCheckConfig& config, double floor_share);
 
