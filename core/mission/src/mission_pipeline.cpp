@@ -488,11 +488,13 @@ double MissionPipeline::predicted_constraint(const Candidate& candidate) const {
   const MapMatchConfig& m = *config_.matching;
   const Eigen::Vector3d& at = candidate.position;
   const double voxel = m.registration.voxel_m;
+  Viewpoints views;
   const PointCloud map = points_of(match_sources(at.x(), at.y(), m.target_radius_m), at.x(), at.y(),
-                                   m.target_radius_m, nullptr, voxel);
+                                   m.target_radius_m, &views, voxel);
   const Eigen::Vector3f floor = at.cast<float>();
   const Eigen::Vector3f eye = floor + scanner_view().origins.front();
-  const PointCloud seen = visible_points(map, eye, voxel, m.target_radius_m, config_.view_check);
+  const PointCloud seen =
+      visible_points(map, eye, voxel, m.target_radius_m, config_.view_check, views);
   if (seen.empty()) return 0;
   PointCloud target, source;
   target.points.reserve(map.size());

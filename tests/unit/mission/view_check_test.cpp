@@ -94,6 +94,34 @@ TEST(VisiblePoints, TheGroundIsSeenAsSparselyAsAScanSeesIt) {
   EXPECT_LT(far_seen, far / 3);
 }
 
+// A building's corner from beside its south face: the part of that face nearest the corner was
+// never scanned, but its east face was, from the east. The east face is the far side of the
+// building from here and hides behind the missing wall; only the viewpoints tell.
+TEST(VisiblePoints, TheFarFaceOfABuildingIsNotSeenThroughAWallNotYetScanned) {
+  PointCloud map;
+  Viewpoints views;
+  views.origins = {{0, -10, 1.5f}, {40, 10, 1.5f}};  // the south scan's, the east scan's
+  add_wall_along_x(map, 3, -30, 5, 10);              // the south face, seen up to x = 5 of 10
+  views.origin_of.resize(map.size(), 0);
+  for (float y = 3; y <= 13; y += kVoxel) {  // the east face, x = 10, seen from the east
+    for (float z = 0; z <= 10; z += kVoxel) map.points.emplace_back(10, y, z);
+  }
+  views.origin_of.resize(map.size(), 1);
+  const Eigen::Vector3f eye(8, 0, 1.5f);
+  // Without the viewpoints the east face shows through the gap; with them it does not (but for
+  // its corners, where the neighbours make no plane to tell a side by), and the south face's
+  // points still do.
+  const std::size_t through = count_near_x(visible_points(map, eye, kVoxel, 60, {}), 10);
+  EXPECT_GT(through, 100u);
+  const PointCloud seen = visible_points(map, eye, kVoxel, 60, {}, views);
+  EXPECT_LE(count_near_x(seen, 10), 4u);
+  std::size_t south = 0;
+  for (const auto& p : seen.points) south += std::abs(p.y() - 3) < 0.01f ? 1 : 0;
+  EXPECT_GT(south, 100u);
+  // Seen from the east, the east face is there.
+  EXPECT_GT(count_near_x(visible_points(map, {30, 8, 1.5f}, kVoxel, 60, {}, views), 10), 100u);
+}
+
 // The weakest constraint of what a scanner at the origin sees, as the matcher judges it.
 double predicted(const PointCloud& map) {
   const PointCloud seen = visible_points(map, {0, 0, 1.5f}, kVoxel, 60, {});

@@ -5,6 +5,7 @@
 #include <functional>
 
 #include "scanplan/geometry/point_cloud.hpp"
+#include "scanplan/geometry/viewpoints.hpp"
 #include "scanplan/planning/scan_planner.hpp"
 
 namespace scanplan {
@@ -29,6 +30,10 @@ struct ViewCheckConfig {
   // height), so the share is well above that.
   double hidden_m = 0.5;
   double hidden_share = 0.25;
+  // Where the viewpoints of the map's points are known, a point on a surface whose normal
+  // (turned toward the scanner that saw it) points away from the eye by more than this cosine
+  // is on the far side of something solid: it hides, and is not returned.
+  double back_face_cos = 0.05;
   // A candidate whose predicted weakest constraint (AlignmentQuality::weakest_constraint over
   // the visible points) falls below this keeps the share s² of its score, s = constraint /
   // min_constraint (at least RegistrabilityConfig::floor_share). Below the matcher's own 0.03:
@@ -44,9 +49,12 @@ struct ViewCheckConfig {
 // a voxel and hides what lies behind the bins its voxel spans, so that a near wall the thinning
 // left holes in still hides what is behind it; far off, where a bin spans several voxels (the
 // ground at a grazing angle), only the nearest is returned, as sparse as the scan will be.
-// Throws std::invalid_argument for bins that are no angle.
+// With `views` (where each map point was seen from), points on the far side of a surface are not
+// returned (ViewCheckConfig::back_face_cos). Throws std::invalid_argument for bins that are no
+// angle.
 PointCloud visible_points(const PointCloud& map, const Eigen::Vector3f& eye, double voxel_m,
-                          double max_range_m, const ViewCheckConfig& config);
+                          double max_range_m, const ViewCheckConfig& config,
+                          const Viewpoints& views = {});
 
 // Checks the best candidates of `plan` in rank order with `constraint` (a candidate's predicted
 // weakest constraint; only candidates with a forecast, Candidate::registrability, are checked)
