@@ -38,17 +38,6 @@ TravelMap travel_map(const MlsMap& map, const MovableRegion& movable, const Eige
   t.parent = CellGrid<std::int32_t>(grid.origin, grid.cols, grid.rows, grid.cell_m, -1);
   if (grid.values.empty()) return t;
 
-  // The floor height per movable cell; NaN marks cells not to be driven on.
-  std::vector<float> floor(grid.values.size(), std::nanf(""));
-  for (std::size_t o = 0; o < grid.values.size(); ++o) {
-    if (grid.values[o] < 0) continue;
-    const CellIndex c = grid.index_at(o);
-    const Eigen::Vector2d centre = map.center_of(c);
-    if (within && !within->contains(centre.x(), centre.y())) continue;
-    if (in_any(avoid, centre)) continue;
-    floor[o] = map.cell(c)->patches[grid.values[o]].max_z;
-  }
-
   // The start as movable_region chose it: the robot's cell, else the neighbour whose floor is
   // nearest the robot's height.
   const CellIndex rc = map.index_of(robot.x(), robot.y());
@@ -71,6 +60,22 @@ TravelMap travel_map(const MlsMap& map, const MovableRegion& movable, const Eige
   }
   if (start < 0) return t;
   t.start = grid.index_at(static_cast<std::size_t>(start));
+
+  // A robot standing outside the target region (it was driven there by hand, or the operator
+  // drew the region elsewhere) may drive anywhere to get into it; one inside keeps to it.
+  const Eigen::Vector2d start_centre = map.center_of(t.start);
+  const TargetRegion* keep_in =
+      within && within->contains(start_centre.x(), start_centre.y()) ? within : nullptr;
+  // The floor height per movable cell; NaN marks cells not to be driven on.
+  std::vector<float> floor(grid.values.size(), std::nanf(""));
+  for (std::size_t o = 0; o < grid.values.size(); ++o) {
+    if (grid.values[o] < 0) continue;
+    const CellIndex c = grid.index_at(o);
+    const Eigen::Vector2d centre = map.center_of(c);
+    if (keep_in && !keep_in->contains(centre.x(), centre.y())) continue;
+    if (in_any(avoid, centre)) continue;
+    floor[o] = map.cell(c)->patches[grid.values[o]].max_z;
+  }
   if (std::isnan(floor[static_cast<std::size_t>(start)])) {
     floor[static_cast<std::size_t>(start)] =
         map.cell(t.start)->patches[grid.values[static_cast<std::size_t>(start)]].max_z;

@@ -52,5 +52,23 @@ TEST(TravelMap, GoesRoundAWallAndNotUpAStep) {
   EXPECT_TRUE(inside.reachable({5, 12}));
 }
 
+// The server's default region is a 200 m square around the first scan. A robot standing 2 m past
+// its edge (driven there by hand, or by a planner that knew a larger region) got no candidate at
+// all: the way back in lay outside the region too (server_bench's scan 20).
+TEST(TravelMap, ARobotOutsideTheRegionDrivesIntoIt) {
+  MlsMap map;
+  map.insert(slab(0, 30, 0, 20, 0.0f));
+  const TargetRegion region = TargetRegion::rectangle({0, 0}, {20, 20});
+  const Eigen::Vector3d robot(25.5, 5.5, 0);
+  const MovableRegion movable = movable_region(map, robot);
+  const TravelMap t = travel_map(map, movable, robot, {}, &region);
+  EXPECT_NEAR(t.distance({15, 5}), 10.0, 1e-5);
+  EXPECT_TRUE(t.reachable({2, 18}));
+  // From inside, the drive keeps to the region.
+  const TravelMap in = travel_map(map, movable, {15.5, 5.5, 0}, {}, &region);
+  EXPECT_FALSE(in.reachable({25, 5}));
+  EXPECT_TRUE(in.reachable({2, 18}));
+}
+
 }  // namespace
 }  // namespace scanplan

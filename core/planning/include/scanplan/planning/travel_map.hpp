@@ -28,8 +28,9 @@ struct TravelMap {
 
 // From the movable cell under `robot` (x, y, floor z), or the nearest movable neighbour when the
 // robot's own cell is not movable. With `within`, only cells whose centre is inside it are
-// driven through (the start excepted), and none whose centre lies in one of `avoid` (the
-// operator's no-go zones). All distances are +inf when there is no start cell.
+// driven through (the start excepted) when the start is inside it; from a start outside it
+// every cell is, so that the robot can get in. None whose centre lies in one of `avoid` (the
+// operator's no-go zones) is. All distances are +inf when there is no start cell.
 TravelMap travel_map(const MlsMap& map, const MovableRegion& movable, const Eigen::Vector3d& robot,
                      const MovableConfig& config, const TargetRegion* within = nullptr,
                      const std::vector<TargetRegion>& avoid = {});
