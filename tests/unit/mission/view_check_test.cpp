@@ -120,6 +120,10 @@ TEST(VisiblePoints, TheFarFaceOfABuildingIsNotSeenThroughAWallNotYetScanned) {
   EXPECT_GT(south, 100u);
   // Seen from the east, the east face is there.
   EXPECT_GT(count_near_x(visible_points(map, {30, 8, 1.5f}, kVoxel, 60, {}, views), 10), 100u);
+  // Viewpoints that do not describe the map (one point short) are not used.
+  Viewpoints short_by_one = views;
+  short_by_one.origin_of.pop_back();
+  EXPECT_EQ(count_near_x(visible_points(map, eye, kVoxel, 60, {}, short_by_one), 10), through);
 }
 
 // The weakest constraint of what a scanner at the origin sees, as the matcher judges it.
