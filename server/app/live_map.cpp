@@ -434,7 +434,8 @@ GoalSite goal_site(const MappingPipeline& mapping, const PlannerConfig& planner,
   if (!travel.reachable(cell)) {
     throw GoalRefused("unreachable", std::string(where) +
                                          " is movable but no drive inside the target region "
-                                         "and around the no-go zones leads there from the robot");
+                                         "(from a robot inside it) and around the no-go zones "
+                                         "leads there from the robot");
   }
   const auto offset = movable.patch.offset(cell);
   const float floor_z = map.cell(cell)->patches[movable.patch.values[*offset]].mean_z;

@@ -133,8 +133,11 @@ class SurfaceNormals {
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> eig;
     eig.computeDirect(cov);
     const Eigen::Vector3f values = eig.eigenvalues();
-    // Flat across, spread along two directions: a plane.
-    if (!(values(0) < kFlatness * values(1))) return Eigen::Vector3f::Zero();
+    // Flat across, spread along two directions: a plane (not a line of points along a post or
+    // an edge, whose two small spreads are noise).
+    if (!(values(0) < kFlatness * values(1) && values(1) > kFlatness * values(2))) {
+      return Eigen::Vector3f::Zero();
+    }
     return eig.eigenvectors().col(0);
   }
 
@@ -216,6 +219,10 @@ PointCloud visible_points(const PointCloud& map, const Eigen::Vector3f& eye, dou
   // predicted where the match met 0–0.014).
   const bool sided = views.fit(map.size());
   constexpr float kSameSideCos = 0.5f;
+  // A surface its scanner saw edge-on (the far ground, 1.5 m below a sensor 60 m off: a cosine
+  // of 0.025) has no side a normal a degree or two off could tell: kept.
+  constexpr float kSideSeenCos = 0.15f;
+  const auto back_face = static_cast<float>(config.back_face_cos);
   const std::optional<SurfaceNormals> normals =
       sided ? std::make_optional<SurfaceNormals>(map, front, voxel_m) : std::nullopt;
   PointCloud out;
@@ -230,9 +237,11 @@ PointCloud visible_points(const PointCloud& map, const Eigen::Vector3f& eye, dou
       // cost).
       if (to_eye.dot(to_view) < kSameSideCos) {
         const Eigen::Vector3f n = normals->normal(f);
+        const float facing_view = n.dot(to_view);
         // The normal turned toward the scanner that saw the point; the eye behind the surface.
-        const float seen_side = n.dot(to_view) < 0 ? -1.0f : 1.0f;
-        if (seen_side * n.dot(to_eye) < -config.back_face_cos) continue;
+        if (std::abs(facing_view) >= kSideSeenCos &&
+            (facing_view < 0 ? -1.0f : 1.0f) * n.dot(to_eye) < -back_face)
+          continue;
       }
     }
     out.points.push_back(p);

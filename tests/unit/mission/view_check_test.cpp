@@ -100,14 +100,18 @@ TEST(VisiblePoints, TheGroundIsSeenAsSparselyAsAScanSeesIt) {
 TEST(VisiblePoints, TheFarFaceOfABuildingIsNotSeenThroughAWallNotYetScanned) {
   PointCloud map;
   Viewpoints views;
-  views.origins = {{0, -10, 1.5f}, {40, 10, 1.5f}};  // the south scan's, the east scan's
+  views.origins = {{0, -10, 1.5f}, {40, 20, 1.5f}};  // the south scan's, the east scan's
   add_wall_along_x(map, 3, -30, 5, 10);              // the south face, seen up to x = 5 of 10
   views.origin_of.resize(map.size(), 0);
-  for (float y = 3; y <= 13; y += kVoxel) {  // the east face, x = 10, seen from the east
+  for (float y = 3; y <= 30; y += kVoxel) {  // the east face, x = 10, seen from the east
     for (float z = 0; z <= 10; z += kVoxel) map.points.emplace_back(10, y, z);
   }
   views.origin_of.resize(map.size(), 1);
-  const Eigen::Vector3f eye(8, 0, 1.5f);
+  for (float y = 14; y <= 20; y += kVoxel) {  // a wall behind the building, seen from the south
+    for (float z = 0; z <= 6; z += kVoxel) map.points.emplace_back(15, y, z);
+  }
+  views.origin_of.resize(map.size(), 0);
+  const Eigen::Vector3f eye(7, 0, 1.5f);
   // Without the viewpoints the east face shows through the gap; with them it does not (but for
   // its corners, where the neighbours make no plane to tell a side by), and the south face's
   // points still do.
@@ -115,11 +119,15 @@ TEST(VisiblePoints, TheFarFaceOfABuildingIsNotSeenThroughAWallNotYetScanned) {
   EXPECT_GT(through, 100u);
   const PointCloud seen = visible_points(map, eye, kVoxel, 60, {}, views);
   EXPECT_LE(count_near_x(seen, 10), 4u);
+  // The far face still hides what stands behind the building.
+  EXPECT_EQ(count_near_x(seen, 15), 0u);
   std::size_t south = 0;
   for (const auto& p : seen.points) south += std::abs(p.y() - 3) < 0.01f ? 1 : 0;
   EXPECT_GT(south, 100u);
-  // Seen from the east, the east face is there.
+  // Seen from the east, the east face is there: from near where it was seen, and from the
+  // south-east, far enough round for its side to be told.
   EXPECT_GT(count_near_x(visible_points(map, {30, 8, 1.5f}, kVoxel, 60, {}, views), 10), 100u);
+  EXPECT_GT(count_near_x(visible_points(map, {12, -10, 1.5f}, kVoxel, 60, {}, views), 10), 100u);
   // Viewpoints that do not describe the map (one point short) are not used.
   Viewpoints short_by_one = views;
   short_by_one.origin_of.pop_back();

@@ -89,7 +89,8 @@ struct PlannerConfig {
   double fleet_tie_share = 0.02;
   // A scan that would gain less than this (F, in m²) is not worth making.
   double min_gain_m2 = 1.0;
-  // Candidates and paths keep to cells whose centre is in the target region.
+  // Candidates and paths keep to cells whose centre is in the target region (paths from a robot
+  // standing outside it may cross any cell: travel_map).
   bool stay_in_target = true;
   int threads = 0;  // OpenMP threads for the evaluations; 0: the OpenMP default
   VisibilityConfig visibility;
