@@ -68,6 +68,12 @@ TEST(TravelMap, ARobotOutsideTheRegionDrivesIntoIt) {
   const TravelMap in = travel_map(map, movable, {15.5, 5.5, 0}, {}, &region);
   EXPECT_FALSE(in.reachable({25, 5}));
   EXPECT_TRUE(in.reachable({2, 18}));
+  // The no-go zones hold all the same: one across the way in from x = 21 to 23, y up to 15,
+  // makes the drive go round its end.
+  const std::vector<TargetRegion> no_go{TargetRegion::rectangle({21, 0}, {23, 15})};
+  const TravelMap round = travel_map(map, movable, robot, {}, &region, no_go);
+  EXPECT_GT(round.distance({15, 5}), 20.0);
+  EXPECT_FALSE(round.reachable({22, 5}));
 }
 
 }  // namespace
