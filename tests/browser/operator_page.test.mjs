@@ -6,7 +6,9 @@
 // Screenshots: $SCREENSHOT_DIR (build/screenshots under ctest).
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { requestScan, scanAndWait, startStack, worldVariant, scratchDir } from '../support/stack.mjs';
+import { createRequire } from 'node:module';
+import { join } from 'node:path';
+import { requestScan, requireEnv, scanAndWait, startStack, worldVariant, scratchDir } from '../support/stack.mjs';
 import {
   canvasCoverage,
   dataset,
@@ -28,6 +30,8 @@ before(async () => {
   await scanAndWait(stack, 1);
 });
 after(async () => stack && (await stack.stop()));
+
+const WebSocket = createRequire(join(requireEnv('SCANPLAN_SOURCE_DIR'), 'web', 'package.json'))('ws');
 
 const session = async () => (await stack.api('GET', '/api/v1/session')).json();
 const fullMapFetches = (requests) => requests.filter((r) => r.path === '/api/v1/map.drc' && !new URLSearchParams(r.search).has('since'));
@@ -182,11 +186,21 @@ test('operator page: map, candidates, approval, growth by WebSocket chunk, recon
     await frames(page);
     t.diagnostic(`shot: ${await screenshot(page, 'connection_lost.png')}`);
     const before = requests.length;
-    await requestScan(stack);
-    const third = await stack.waitFor('scan 3 in the session', async () => {
-      const s = await session();
-      return s.scans >= 3 ? s : undefined;
+    // The server counts a scan in the session before it has sent the scan's chunk; the link
+    // comes back only after the scan's last event (map_updated), so that the page cannot get
+    // the chunk over its new socket and the REST resume is what is tested.
+    const ws = new WebSocket(`${stack.url.replace('http', 'ws')}/api/v1/events?token=${stack.viewerToken}`);
+    await new Promise((resolve, reject) => { ws.on('open', resolve); ws.on('error', reject); });
+    let processed = false;
+    ws.on('message', (data, isBinary) => {
+      const e = isBinary ? null : JSON.parse(data.toString());
+      if (e?.type === 'map_updated' && e.scan === 3) processed = true;
     });
+    await requestScan(stack);
+    await stack.waitFor('scan 3 processed', async () => processed || undefined);
+    ws.close();
+    const third = await session();
+    assert.equal(third.scans, 3);
     ds = await dataset(page);
     assert.equal(ds.chunks, '2', 'nothing arrives while the link is down');
     await context.setOffline(false);
