@@ -491,21 +491,26 @@ double MissionPipeline::predicted_constraint(const Candidate& candidate) const {
   Viewpoints views;
   const PointCloud map = points_of(match_sources(at.x(), at.y(), m.target_radius_m), at.x(), at.y(),
                                    m.target_radius_m, &views, voxel);
+  // Judged in the candidate's frame, as match_to_map judges a match: one k-d tree over the map
+  // gives the view check its surface normals and then weighs what is seen.
   const Eigen::Vector3f floor = at.cast<float>();
-  const Eigen::Vector3f eye = floor + scanner_view().origins.front();
-  const PointCloud seen =
-      visible_points(map, eye, voxel, m.target_radius_m, config_.view_check, views);
-  if (seen.empty()) return 0;
-  PointCloud target, source;
+  PointCloud target;
   target.points.reserve(map.size());
   for (const Eigen::Vector3f& p : map.points) target.points.push_back(p - floor);
+  for (Eigen::Vector3f& o : views.origins) o -= floor;
+  const AlignmentJudge judge(target);
+  const PointCloud seen = visible_points(target, scanner_view().origins.front(), voxel,
+                                         m.target_radius_m, config_.view_check, views, &judge);
+  if (seen.empty()) return 0;
   // Every third point, as the matcher's judge first weighs its results: the weakest constraint
   // is a share of the points, and the normals cost most of the check.
+  PointCloud source;
   source.points.reserve(seen.size() / 3 + 1);
-  for (std::size_t i = 0; i < seen.size(); i += 3) source.points.push_back(seen.points[i] - floor);
+  for (std::size_t i = 0; i < seen.size(); i += 3) source.points.push_back(seen.points[i]);
   const RegistrationConfig& r = m.registration;
-  return evaluate_alignment(target, source, Eigen::Isometry3d::Identity(), r.dof,
-                            r.score_max_distance_m, r.inlier_distance_m)
+  return judge
+      .evaluate(source, Eigen::Isometry3d::Identity(), r.dof, r.score_max_distance_m,
+                r.inlier_distance_m)
       .weakest_constraint;
 }
 

@@ -1,8 +1,6 @@
 #include "scanplan/mission/view_check.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -67,112 +65,23 @@ class RangeImage {
   std::vector<float> range_;
 };
 
-// The surface normal at a point of the map from its neighbours within 1.5 voxels among `near`
-// (the points of the map that may neighbour one asked about), for the points that ask. The
-// neighbours are gathered from cells twice that wide, so that a point's ball meets at most
-// two a side; each cell's points lie together, found through an open-addressing table
-// (linear probing) of the cells' keys.
-class SurfaceNormals {
- public:
-  SurfaceNormals(const PointCloud& map, const std::vector<std::uint32_t>& near, double voxel_m)
-      : map_(map),
-        reach_(static_cast<float>(1.5 * voxel_m)),
-        inv_cell_(1.0f / (2 * reach_)),
-        slots_(std::bit_ceil(std::max<std::size_t>(2 * near.size(), 16)), {kEmpty, 0}),
-        mask_(slots_.size() - 1) {
-    // Each cell numbered as first met, its points counted, then laid out together.
-    std::vector<std::uint32_t> cell_of(near.size());
-    std::vector<std::uint32_t> count;
-    for (std::size_t k = 0; k < near.size(); ++k) {
-      const std::uint64_t key = key_of(cell_at(map.points[near[k]]));
-      std::size_t at = hash(key);
-      while (slots_[at].key != kEmpty && slots_[at].key != key) at = (at + 1) & mask_;
-      if (slots_[at].key == kEmpty) {
-        slots_[at] = {key, static_cast<std::uint32_t>(count.size())};
-        count.push_back(0);
-      }
-      cell_of[k] = slots_[at].cell;
-      ++count[slots_[at].cell];
-    }
-    begin_.assign(count.size() + 1, 0);
-    for (std::size_t c = 0; c < count.size(); ++c) begin_[c + 1] = begin_[c] + count[c];
-    points_.resize(near.size());
-    std::vector<std::uint32_t> fill(begin_.begin(), begin_.end() - 1);
-    for (std::size_t k = 0; k < near.size(); ++k) points_[fill[cell_of[k]]++] = map.points[near[k]];
-  }
-
-  // Zero where the neighbours make no plane (an edge, a post, a lone point).
-  Eigen::Vector3f normal(std::size_t i) const {
-    const Eigen::Vector3f& p = map_.points[i];
-    const Eigen::Vector3i c0 = cell_at(p - Eigen::Vector3f::Constant(reach_));
-    const float reach_sq = reach_ * reach_;
-    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-    Eigen::Matrix3f outer = Eigen::Matrix3f::Zero();
-    int n = 0;
-    for (int dz = 0; dz <= 1; ++dz) {
-      for (int dy = 0; dy <= 1; ++dy) {
-        for (int dx = 0; dx <= 1; ++dx) {
-          const std::uint64_t key = key_of(c0 + Eigen::Vector3i(dx, dy, dz));
-          std::size_t at = hash(key);
-          while (slots_[at].key != kEmpty && slots_[at].key != key) at = (at + 1) & mask_;
-          if (slots_[at].key == kEmpty) continue;
-          const std::uint32_t cell = slots_[at].cell;
-          for (std::uint32_t k = begin_[cell]; k < begin_[cell + 1]; ++k) {
-            const Eigen::Vector3f q = points_[k] - p;
-            if (q.squaredNorm() > reach_sq) continue;
-            sum += q;
-            outer += q * q.transpose();
-            ++n;
-          }
-        }
-      }
-    }
-    if (n < kMinNeighbours) return Eigen::Vector3f::Zero();
-    const Eigen::Vector3f mean = sum / static_cast<float>(n);
-    const Eigen::Matrix3f cov = outer / static_cast<float>(n) - mean * mean.transpose();
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> eig;
-    eig.computeDirect(cov);
-    const Eigen::Vector3f values = eig.eigenvalues();
-    // Flat across, spread along two directions: a plane (not a line of points along a post or
-    // an edge, whose two small spreads are noise).
-    if (!(values(0) < kFlatness * values(1) && values(1) > kFlatness * values(2))) {
-      return Eigen::Vector3f::Zero();
-    }
-    return eig.eigenvectors().col(0);
-  }
-
- private:
-  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
-  static constexpr int kMinNeighbours = 5;
-  static constexpr float kFlatness = 0.1f;
-  struct Slot {
-    std::uint64_t key;
-    std::uint32_t cell;
-  };
-  Eigen::Vector3i cell_at(const Eigen::Vector3f& p) const {
-    return (p * inv_cell_).array().floor().cast<int>();
-  }
-  static std::uint64_t key_of(const Eigen::Vector3i& v) {
-    const auto part = [](int c) { return static_cast<std::uint64_t>(c + (1 << 20)) & 0x1FFFFF; };
-    return part(v.x()) | part(v.y()) << 21 | part(v.z()) << 42;
-  }
-  std::size_t hash(std::uint64_t key) const {
-    return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask_;
-  }
-
-  const PointCloud& map_;
-  float reach_, inv_cell_;
-  std::vector<Slot> slots_;
-  std::size_t mask_;
-  std::vector<std::uint32_t> begin_;  // each cell's first point in points_, and one past the last
-  std::vector<Eigen::Vector3f> points_;
-};
+// The surface's normal at map point p from the judge's points within 1.5 voxels; zero where they
+// make no plane: a line along a post or an edge has two small spreads, both noise.
+Eigen::Vector3f plane_normal(const AlignmentJudge& judge, const Eigen::Vector3f& p,
+                             double voxel_m) {
+  constexpr double kFlatness = 0.1;
+  const auto shape = judge.local_shape(p, 1.5 * voxel_m);
+  if (!shape) return Eigen::Vector3f::Zero();
+  const Eigen::Vector3d& s = shape->spread;
+  if (!(s(0) < kFlatness * s(1) && s(1) > kFlatness * s(2))) return Eigen::Vector3f::Zero();
+  return shape->normal.cast<float>();
+}
 
 }  // namespace
 
 PointCloud visible_points(const PointCloud& map, const Eigen::Vector3f& eye, double voxel_m,
                           double max_range_m, const ViewCheckConfig& config,
-                          const Viewpoints& views) {
+                          const Viewpoints& views, const AlignmentJudge* judge) {
   if (!(config.bin_deg > 0 && config.bin_deg <= 90)) {
     throw std::invalid_argument("view check: bin_deg must be within (0, 90] degrees, not " +
                                 std::to_string(config.bin_deg));
@@ -200,15 +109,12 @@ PointCloud visible_points(const PointCloud& map, const Eigen::Vector3f& eye, dou
   // thinning.
   constexpr auto kNone = std::numeric_limits<std::uint32_t>::max();
   std::vector<std::uint32_t> first(image.size(), kNone);
-  // The points on the surfaces met (a returned point's neighbours are among them).
-  std::vector<std::uint32_t> front;
   for (std::size_t i = 0; i < map.size(); ++i) {
     const Seen& s = seen[i];
     if (s.range < 0) continue;
     const float hidden = std::max(static_cast<float>(config.hidden_m),
                                   static_cast<float>(config.hidden_share) * s.range);
     if (s.range > image.nearest(s.bin) + hidden) continue;
-    front.push_back(static_cast<std::uint32_t>(i));
     std::uint32_t& f = first[s.bin];
     if (f == kNone || s.range < seen[f].range) f = static_cast<std::uint32_t>(i);
   }
@@ -223,20 +129,20 @@ PointCloud visible_points(const PointCloud& map, const Eigen::Vector3f& eye, dou
   // of 0.025) has no side a normal a degree or two off could tell: kept.
   constexpr float kSideSeenCos = 0.15f;
   const auto back_face = static_cast<float>(config.back_face_cos);
-  const std::optional<SurfaceNormals> normals =
-      sided ? std::make_optional<SurfaceNormals>(map, front, voxel_m) : std::nullopt;
+  std::optional<AlignmentJudge> own_judge;
+  if (sided && !judge) judge = &own_judge.emplace(map);
   PointCloud out;
   for (const std::uint32_t f : first) {
     if (f == kNone) continue;
     const Eigen::Vector3f& p = map.points[f];
-    if (normals) {
+    if (sided) {
       const Eigen::Vector3f to_eye = (eye - p).normalized();
       const Eigen::Vector3f to_view = (views.of(f) - p).normalized();
       // Looked at from within 60° of where it was seen from, a surface is seen from the same
       // side unless both look along it (a normal for every point would double the check's
       // cost).
       if (to_eye.dot(to_view) < kSameSideCos) {
-        const Eigen::Vector3f n = normals->normal(f);
+        const Eigen::Vector3f n = plane_normal(*judge, p, voxel_m);
         const float facing_view = n.dot(to_view);
         // The normal turned toward the scanner that saw the point; the eye behind the surface.
         if (std::abs(facing_view) >= kSideSeenCos &&

@@ -47,6 +47,14 @@ AlignmentQuality evaluate_alignment(const PointCloud& target, const PointCloud& 
                                          inlier_distance_m, with_constraint);
 }
 
+std::optional<AlignmentJudge::LocalShape> AlignmentJudge::local_shape(const Eigen::Vector3f& q,
+                                                                      double radius_m) const {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  const auto max_sq = static_cast<float>(radius_m * radius_m);
+  if (!tree_->local_shape<kNormalNeighbours>(q, max_sq, eig)) return std::nullopt;
+  return LocalShape{eig.eigenvalues(), eig.eigenvectors().col(0)};
+}
+
 AlignmentQuality AlignmentJudge::evaluate(const PointCloud& source,
                                           const Eigen::Isometry3d& source_to_target, Dof dof,
                                           double score_max_distance_m, double inlier_distance_m,

@@ -7,6 +7,7 @@
 #include "scanplan/geometry/point_cloud.hpp"
 #include "scanplan/geometry/viewpoints.hpp"
 #include "scanplan/planning/scan_planner.hpp"
+#include "scanplan/registration/alignment_quality.hpp"
 
 namespace scanplan {
 
@@ -50,11 +51,12 @@ struct ViewCheckConfig {
 // left holes in still hides what is behind it; far off, where a bin spans several voxels (the
 // ground at a grazing angle), only the nearest is returned, as sparse as the scan will be.
 // With `views` (where each map point was seen from), points on the far side of a surface are not
-// returned (ViewCheckConfig::back_face_cos). Throws std::invalid_argument for bins that are no
-// angle.
+// returned (ViewCheckConfig::back_face_cos); the surfaces' normals come from `judge`, one over
+// exactly `map`'s points (the one that then judges the view), else from one built here. Throws
+// std::invalid_argument for bins that are no angle.
 PointCloud visible_points(const PointCloud& map, const Eigen::Vector3f& eye, double voxel_m,
                           double max_range_m, const ViewCheckConfig& config,
-                          const Viewpoints& views = {});
+                          const Viewpoints& views = {}, const AlignmentJudge* judge = nullptr);
 
 // Checks the best candidates of `plan` in rank order with `constraint` (a candidate's predicted
 // weakest constraint; only candidates with a forecast, Candidate::registrability, are checked)

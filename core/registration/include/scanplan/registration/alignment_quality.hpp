@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <memory>
+#include <optional>
 
 #include "scanplan/geometry/point_cloud.hpp"
 #include "scanplan/registration/registration_result.hpp"
@@ -62,6 +63,15 @@ class AlignmentJudge {
   AlignmentQuality evaluate(const PointCloud& source, const Eigen::Isometry3d& source_to_target,
                             Dof dof, double score_max_distance_m, double inlier_distance_m,
                             bool with_constraint = true) const;
+
+  // The shape of the target's surface near q, from its up to 8 nearest points within radius_m
+  // (nothing with fewer than 5): the spreads (eigenvalues of their scatter, ascending) and the
+  // direction of the least, the surface's normal where they make a plane.
+  struct LocalShape {
+    Eigen::Vector3d spread;
+    Eigen::Vector3d normal;
+  };
+  std::optional<LocalShape> local_shape(const Eigen::Vector3f& q, double radius_m) const;
 
  private:
   const PointCloud& target_;
