@@ -19,18 +19,9 @@ namespace scanplan::server {
 
 namespace {
 
-struct PoseChange {
-  double metres = 0, degrees = 0;
-};
-
 using Clock = std::chrono::steady_clock;
 double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
-}
-
-PoseChange change(const Pose& a, const Pose& b) {
-  return {std::hypot(b.x - a.x, b.y - a.y, b.z - a.z),
-          std::abs(rad2deg(std::remainder(b.yaw - a.yaw, 2 * M_PI)))};
 }
 
 // Where a stored scan joins the mission: its match (if believed) with the match's information,
@@ -203,7 +194,7 @@ LiveMap::Followed LiveMap::follow_mission(std::vector<StoredScan> scans,
     // The pipeline makes a scan's points anew only when the graph moved it past replace_m /
     // _deg (MissionPipeline::placed_scans): the map shows the same cloud, never a copy of it.
     const bool moved = placed[i] != mission_.placed_scans()[i];
-    const PoseChange d = change(scans[i].placed, mission_.cloud_poses()[i]);
+    const PoseChange d = pose_change(scans[i].placed, mission_.cloud_poses()[i]);
     if (moved) {
       scans[i].placed = mission_.cloud_poses()[i];
       placed[i] = mission_.placed_scans()[i];
@@ -625,7 +616,7 @@ LiveMap::Rebuilt LiveMap::rebuild(const std::vector<StoredScan>& keep, const Sca
     const auto was = held.find(s.id);
     const auto chunk = chunks_.find(s.id);
     const bool same = was != held.end() && chunk != chunks_.end() &&
-                      change(was->second.second, s.placed).metres == 0 &&
+                      pose_change(was->second.second, s.placed).metres == 0 &&
                       was->second.second.yaw == s.placed.yaw;
     chunks[s.id] = same ? chunk->second : nullptr;
   }

@@ -249,8 +249,8 @@ void ScanIntake::resume_poses() {
     const auto it = recorded.find(s.id);
     const Pose was = it == recorded.end() ? session_.scan(s.id)->placed : it->second.pose;
     const bool was_in = it == recorded.end() || it->second.in_map;
-    const double moved = std::hypot(s.placed.x - was.x, s.placed.y - was.y, s.placed.z - was.z);
-    if (moved <= kResumeToleranceM && in_map == was_in) continue;
+    const PoseChange moved = pose_change(was, s.placed);
+    if (moved.metres <= kResumeToleranceM && in_map == was_in) continue;
     differ.poses.push_back({s.id, s.placed, in_map});
     if (in_map && !was_in) {
       differ.joined.push_back(s.id);
@@ -258,10 +258,8 @@ void ScanIntake::resume_poses() {
       differ.left.push_back(s.id);
     } else if (in_map) {
       differ.moved.push_back(s.id);
-      differ.max_moved_m = std::max(differ.max_moved_m, moved);
-      differ.max_turned_deg =
-          std::max(differ.max_turned_deg,
-                   std::abs(rad2deg(std::remainder(s.placed.yaw - was.yaw, 2 * M_PI))));
+      differ.max_moved_m = std::max(differ.max_moved_m, moved.metres);
+      differ.max_turned_deg = std::max(differ.max_turned_deg, moved.degrees);
     }
   }
   if (differ.poses.empty()) return;

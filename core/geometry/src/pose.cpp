@@ -31,4 +31,9 @@ Pose Pose::from_isometry(const Eigen::Isometry3d& T) {
   return p;
 }
 
+PoseChange pose_change(const Pose& from, const Pose& to) {
+  return {std::hypot(to.x - from.x, to.y - from.y, to.z - from.z),
+          std::abs(rad2deg(std::remainder(to.yaw - from.yaw, 2 * M_PI)))};
+}
+
 }  // namespace scanplan

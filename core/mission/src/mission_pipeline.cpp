@@ -15,18 +15,9 @@ namespace {
 constexpr double kNoticeableM = 0.005;
 constexpr double kNoticeableDeg = 0.01;
 
-struct PoseChange {
-  double metres = 0, degrees = 0;
-};
-
 using Clock = std::chrono::steady_clock;
 double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
-}
-
-PoseChange change(const Pose& a, const Pose& b) {
-  return {std::hypot(b.x - a.x, b.y - a.y, b.z - a.z),
-          std::abs(rad2deg(std::remainder(b.yaw - a.yaw, 2 * M_PI)))};
 }
 
 // `config` searching as far as the pose it starts from may be off (ScanGraph's uncertainty), and
@@ -232,7 +223,7 @@ std::optional<MissionPipeline::SensorFix> MissionPipeline::sensors_place(
 // drove far since its last anchored scan (match_input), or it started from a pose that may be
 // off by more than that.
 bool MissionPipeline::unsure(const Placement& where) const {
-  const PoseChange d = change(prior(where.reported, where.track), where.placed);
+  const PoseChange d = pose_change(prior(where.reported, where.track), where.placed);
   const std::optional<MoveUncertainty> u =
       graph_->prior_uncertainty(where.track, where.reported, where.driven_m);
   return d.metres > config_.matching->max_correction_m ||
@@ -291,7 +282,7 @@ bool MissionPipeline::rematch_refused(GraphUpdate& update) {
         const std::size_t u = retries[r].scan;
         if (!m.applied) return;
         if (beyond_reach(graph_->uncertainty(u)) ||
-            change(poses_[u], m.placed).metres > config_.matching->max_correction_m) {
+            pose_change(poses_[u], m.placed).metres > config_.matching->max_correction_m) {
           graph_->offer_match_to_map(u, m.placed, m.information);
         } else {
           graph_->add_match_to_map(u, m.placed, m.information);
@@ -307,7 +298,7 @@ MapCorrection MissionPipeline::correction(const GraphUpdate& update,
                                           const std::vector<Pose>& before) const {
   MapCorrection c{update, {}, 0, 0};
   for (std::size_t i = 0; i < before.size(); ++i) {
-    const PoseChange d = change(before[i], poses_[i]);
+    const PoseChange d = pose_change(before[i], poses_[i]);
     if (d.metres > kNoticeableM || d.degrees > kNoticeableDeg) c.moved.push_back(i);
     c.max_moved_m = std::max(c.max_moved_m, d.metres);
     c.max_turned_deg = std::max(c.max_turned_deg, d.degrees);
@@ -339,13 +330,13 @@ void MissionPipeline::follow_graph() {
 // the one it showed (the long session's heap: 417 MB of map-frame points for 259 MB of
 // scans). What the graph moved less is applied where the points are used (points_of, at_estimate).
 bool MissionPipeline::cloud_lags(std::size_t i) const {
-  const PoseChange d = change(cloud_poses_[i], poses_[i]);
+  const PoseChange d = pose_change(cloud_poses_[i], poses_[i]);
   return d.metres > config_.replace_m || d.degrees > config_.replace_deg;
 }
 
 // Against where the map holds it, not the graph's previous estimate: small moves add up.
 bool MissionPipeline::map_lags(std::size_t i) const {
-  const PoseChange d = change(map_poses_[i], poses_[i]);
+  const PoseChange d = pose_change(map_poses_[i], poses_[i]);
   return d.metres > config_.remap_m || d.degrees > config_.remap_deg;
 }
 

@@ -287,8 +287,8 @@ GraphSolveReport ScanGraph::solve() {
 
 // Whether pose `a` and `b` of one scan agree as two matches of it must (agree_m / _deg).
 bool ScanGraph::agree(const Pose& a, const Pose& b) const {
-  return std::hypot(a.x - b.x, a.y - b.y, a.z - b.z) <= config_.agree_m &&
-         std::abs(rad2deg(std::remainder(a.yaw - b.yaw, 2 * M_PI))) <= config_.agree_deg;
+  const PoseChange d = pose_change(a, b);
+  return d.metres <= config_.agree_m && d.degrees <= config_.agree_deg;
 }
 
 // A far map match waiting for its robot's next scan (pending_map_) is believed, too, when a

@@ -16,6 +16,13 @@ struct Pose {
   bool operator==(const Pose&) const = default;
 };
 
+// How far a pose moved: the distance in x, y and z (metres) and the turn in yaw, either way
+// (degrees).
+struct PoseChange {
+  double metres = 0, degrees = 0;
+};
+PoseChange pose_change(const Pose& from, const Pose& to);
+
 constexpr double deg2rad(double d) {
   return d * 0.017453292519943295;
 }
