@@ -15,6 +15,7 @@ import { mkdirSync, mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { startStack, scanAndWait } from '../support/stack.mjs';
+import { canvasCoverage, frames } from '../support/browser.mjs';
 
 const require = createRequire(new URL('../../web/package.json', import.meta.url));
 
@@ -108,39 +109,9 @@ test('map view shows the coloured point cloud', { timeout: 150000 }, async (t) =
     assert.equal(ds.error || '', '', `error shown: ${ds.error}`);
 
     // Let a frame or two render after the geometry arrived.
-    await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+    await frames(page);
 
-    // Count pixels of the WebGL canvas that differ from the background (the most frequent colour).
-    const pix = await page.evaluate(() => {
-      const src = document.querySelector('#view canvas');
-      if (!src) return { error: 'no canvas' };
-      const c = document.createElement('canvas');
-      c.width = src.width;
-      c.height = src.height;
-      const ctx = c.getContext('2d', { willReadFrequently: true });
-      ctx.drawImage(src, 0, 0);
-      const d = ctx.getImageData(0, 0, c.width, c.height).data;
-      const hist = new Map();
-      for (let i = 0; i < d.length; i += 4) {
-        const k = (d[i] << 16) | (d[i + 1] << 8) | d[i + 2];
-        hist.set(k, (hist.get(k) || 0) + 1);
-      }
-      let bg = 0;
-      let best = -1;
-      for (const [k, n] of hist) if (n > best) [bg, best] = [k, n];
-      const br = bg >> 16, bgG = (bg >> 8) & 255, bb = bg & 255;
-      let differ = 0;
-      const hues = new Set();
-      for (let i = 0; i < d.length; i += 4) {
-        const diff = Math.abs(d[i] - br) + Math.abs(d[i + 1] - bgG) + Math.abs(d[i + 2] - bb);
-        if (diff > 24) {
-          differ++;
-          hues.add(((d[i] >> 5) << 6) | ((d[i + 1] >> 5) << 3) | (d[i + 2] >> 5)); // coarse 3-3-3 bit colour bins
-        }
-      }
-      const total = c.width * c.height;
-      return { width: c.width, height: c.height, total, differ, fraction: differ / total, colours: hues.size, bg: [br, bgG, bb] };
-    });
+    const pix = await canvasCoverage(page);
     assert.ok(!pix.error, pix.error);
     t.diagnostic(`canvas ${pix.width}x${pix.height}: ${(pix.fraction * 100).toFixed(2)}% non-background pixels, ${pix.colours} colour bins, background rgb(${pix.bg})`);
     assert.ok(pix.width >= 300 && pix.height >= 200, `canvas too small: ${pix.width}x${pix.height}`);

@@ -96,7 +96,10 @@ export async function waitForData(page, what, predicate, arg, timeout = 30000) {
   }
 }
 
-/** Share of the map canvas's pixels that differ from its background (the most frequent colour). */
+/**
+ * Share of the map canvas's pixels that differ from its background (the most frequent colour),
+ * and how many coarse colours (3 bits a channel) those pixels take.
+ */
 export function canvasCoverage(page) {
   return page.evaluate(() => {
     const src = document.querySelector('#view canvas');
@@ -117,10 +120,14 @@ export function canvasCoverage(page) {
     for (const [k, n] of hist) if (n > best) [bg, best] = [k, n];
     const br = bg >> 16, bgG = (bg >> 8) & 255, bb = bg & 255;
     let differ = 0;
+    const hues = new Set();
     for (let i = 0; i < d.length; i += 4) {
-      if (Math.abs(d[i] - br) + Math.abs(d[i + 1] - bgG) + Math.abs(d[i + 2] - bb) > 24) differ++;
+      if (Math.abs(d[i] - br) + Math.abs(d[i + 1] - bgG) + Math.abs(d[i + 2] - bb) > 24) {
+        differ++;
+        hues.add(((d[i] >> 5) << 6) | ((d[i + 1] >> 5) << 3) | (d[i + 2] >> 5));
+      }
     }
-    return { width: c.width, height: c.height, fraction: differ / (c.width * c.height) };
+    return { width: c.width, height: c.height, fraction: differ / (c.width * c.height), colours: hues.size, bg: [br, bgG, bb] };
   });
 }
 
