@@ -59,6 +59,12 @@ RegistrationConfig widened(RegistrationConfig config, const MoveUncertainty& pri
   config.search.prior_sigma_xy_m = prior.xy_m;
   config.search.prior_sigma_yaw_deg = prior.yaw_deg;
   config.search.ambiguity_ratio = 0.8;
+  // A result the surfaces fix only weakly is believed on restarts as far from its start as the
+  // start may be off (4σ, as restart_max_shift_m's 4 m is of the absolute sensors' 1 m; never
+  // beyond the widest search): after drives of 90–130 m the odometry was 6–7 m off, and right
+  // matches there (1–3 cm from the truth) were refused untried (issue 17).
+  config.restart_max_shift_m =
+      std::max(config.restart_max_shift_m, std::min(4 * prior.xy_m, kWidestSearchM));
   const double xy = std::min(3 * prior.xy_m, kWidestSearchM);
   const double yaw = std::min(3 * prior.yaw_deg, kWidestSearchDeg);
   if (xy <= config.search.xy_range_m && yaw <= config.search.yaw_range_deg) return config;
@@ -400,6 +406,16 @@ Pose ScanGraph::placed_now(std::size_t k, const MapCandidate& c) const {
                  at.pitch);
 }
 
+// Where scan k likeliest lies: where its map match waiting for confirmation puts it, else where
+// the graph has it. A match waits because it moved the scan farther than the odometry usually
+// errs; a pair searched from the odometry's estimate would then end beyond max_search_shift_m,
+// and a scan matched right (2.7 cm) stayed out of the map, 7 m off, although later scans saw
+// what it saw (issue 17). A pair with an anchored scan believes the match only where it agrees
+// (later_pair_confirms).
+Pose ScanGraph::likeliest(std::size_t k) const {
+  return pending_map_[k] ? placed_now(k, *pending_map_[k]) : graph_.pose(k);
+}
+
 void ScanGraph::tie_to_map(std::size_t k, const MapCandidate& c, const char* origin) {
   graph_.set_pose(k, placed_now(k, c));  // a levelled match keeps the measured tilt
   anchored_[k] = 1;
@@ -421,7 +437,7 @@ void ScanGraph::match_pairs(std::size_t k, bool matched_to_map, GraphUpdate& upd
     // correlated copies of it, which bend the graph (a 1 cm sideways error 25 m away turns a
     // scan by 0.02°). A scan the map does not hold yet is what a pair can tie in.
     if (matched_to_map && anchored_[j]) continue;
-    const Pose& p = graph_.pose(j);
+    const Pose p = likeliest(j);
     const double d = std::hypot(p.x - at.x, p.y - at.y);
     if (d <= config_.pair_radius_m) near.emplace_back(d, j);
   }
@@ -462,7 +478,7 @@ MoveUncertainty ScanGraph::relative_uncertainty(std::size_t from, std::size_t to
 }
 
 ScanGraph::PairStart ScanGraph::pair_start(std::size_t from, std::size_t to) const {
-  return {level(graph_.pose(from)), level(graph_.pose(to)), relative_uncertainty(from, to)};
+  return {level(likeliest(from)), level(likeliest(to)), relative_uncertainty(from, to)};
 }
 
 std::optional<GraphEdge> ScanGraph::match_pair(std::size_t from, std::size_t to,

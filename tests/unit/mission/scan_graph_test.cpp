@@ -41,16 +41,20 @@ TEST(ScanGraph, TheSearchWidensWithTheUncertaintyButNotWithoutBound) {
   EXPECT_EQ(same.search.prior_sigma_xy_m, 1.0);
   EXPECT_EQ(same.search.prior_sigma_yaw_deg, 3.0);
   EXPECT_GT(same.search.ambiguity_ratio, 0.0);
+  EXPECT_EQ(same.restart_max_shift_m, base.restart_max_shift_m);
 
   const RegistrationConfig wide = widened(base, {3.0, 0.1, 2.0});
   EXPECT_DOUBLE_EQ(wide.search.xy_range_m, 9.0);
   EXPECT_DOUBLE_EQ(wide.search.yaw_range_deg, base.search.yaw_range_deg);
   EXPECT_GE(wide.search.hypotheses, 5);
   EXPECT_GT(wide.search.ambiguity_ratio, 0.0) << "a wider search may span a look-alike";
+  // A weakly fixed result is believed on restarts as far off as the start may be: 4σ.
+  EXPECT_DOUBLE_EQ(wide.restart_max_shift_m, 12.0);
 
   const RegistrationConfig widest = widened(base, {50.0, 1.0, 40.0});
   EXPECT_DOUBLE_EQ(widest.search.xy_range_m, kWidestSearchM);
   EXPECT_DOUBLE_EQ(widest.search.yaw_range_deg, kWidestSearchDeg);
+  EXPECT_DOUBLE_EQ(widest.restart_max_shift_m, kWidestSearchM);
 }
 
 TEST(ScanGraph, OdometryIsAsSureAsTheDriftModelSays) {
@@ -247,6 +251,30 @@ TEST(ScanGraph, AWaitingScanIsBelievedWhenAPairWithALaterScanInTheMapAgrees) {
       EXPECT_TRUE(confirmed);
     }
   }
+}
+
+// A pair with a waiting scan is searched from where its map match puts it: the odometry that
+// made the match wait put the scan farther off than a pair may correct (max_search_shift_m), and
+// on the campus loop a scan matched to 2.7 cm stayed out of the map, 7 m off, although later
+// scans saw what it saw. Robot 1's scan is reported 7 m off; a second robot's scan 6 m from it,
+// placed by its own map match, confirms it.
+TEST(ScanGraph, AWaitingScanFarOffIsConfirmedByAPairSearchedFromItsMatch) {
+  using testing_support::quick_yard_scan;
+  const Pose first = at(-15, -8, 0), truth1 = at(-2, -8, 0), truth2 = at(-2, -14, 0);
+  ScanGraph graph({}, drift());
+  graph.add(quick_yard_scan(first, 1), placement(first, first, false));
+  graph.add(quick_yard_scan(truth1, 2), placement(at(5, -8, 0), truth1, true),
+            /*tentative=*/true);
+  ASSERT_FALSE(graph.anchored(1));
+  ASSERT_GT(std::hypot(graph.poses()[1].x - truth1.x, graph.poses()[1].y - truth1.y),
+            ScanGraphConfig{}.max_search_shift_m);
+  Placement second = placement(truth2, truth2, true);
+  second.track = "robot2";
+  graph.add(quick_yard_scan(truth2, 3), second);
+  ASSERT_TRUE(graph.anchored(2));
+  EXPECT_TRUE(graph.anchored(1)) << graph.outside_reason(1);
+  EXPECT_NEAR(graph.poses()[1].x, truth1.x, 0.05);
+  EXPECT_NEAR(graph.poses()[1].y, truth1.y, 0.05);
 }
 
 // A waiting match said where the scan lies relative to the map as it was when the match ran; if

@@ -78,7 +78,9 @@ PointCloud levelled(PointCloud scan, const Pose& pose);
 // that corrects beyond the sensors' usual reach waits for confirmation
 // (ScanGraph::offer_match_to_map); a pairwise one is refused (max_search_shift_m). Always,
 // narrow or widened, the search is told `prior` (PoseSearchConfig::prior_sigma_xy_m): of two
-// fits, the one nearer where the odometry puts the scan comes first.
+// fits, the one nearer where the odometry puts the scan comes first. A result the surfaces fix
+// only weakly is believed on restarts (RegistrationConfig::restart_max_shift_m) up to 4σ of
+// `prior` from its start.
 inline constexpr double kWidestSearchM = 20.0;
 inline constexpr double kWidestSearchDeg = 45.0;
 RegistrationConfig widened(RegistrationConfig config, const MoveUncertainty& prior);
@@ -180,7 +182,7 @@ class ScanGraph {
   void add_fix(std::size_t scan);
   std::pair<RelativePose, Eigen::Matrix4d> fix_of(std::size_t scan) const;
   void match_pairs(std::size_t scan, bool matched_to_map, GraphUpdate& update);
-  // What a pairwise match starts from: both ends levelled as the graph has them, and how far
+  // What a pairwise match starts from: both ends levelled where they likeliest lie, and how far
   // off that may be.
   struct PairStart {
     Pose from, to;
@@ -217,6 +219,7 @@ class ScanGraph {
   std::optional<MapCandidate> as_found(std::size_t scan, const Pose& placed,
                                        const Eigen::Matrix4d& information) const;
   Pose placed_now(std::size_t scan, const MapCandidate& match) const;
+  Pose likeliest(std::size_t scan) const;
   void tie_to_map(std::size_t scan, const MapCandidate& match, const char* origin);
   Pose implied(const GraphEdge& edge, std::size_t scan) const;
 
