@@ -100,7 +100,8 @@ struct RegistrationConfig {
   // Nor is it believed farther than restart_max_shift_m (x-y) from where the match started: weak
   // evidence only where the pose sensors agree (4σ of their 1 m; in the loop the right results
   // it took lay within 3.7 m, a wrong one 5 m off held on restarts in a repeated facade). Not
-  // scaled with the scene: it is the sensors'.
+  // scaled with the scene: it is the sensors'. With drifting odometry the scan graph raises it to
+  // 4σ of how far the start may be off (widened in scan_graph.hpp).
   bool restart_check = true;
   double restart_min_constraint = 0.005;
   double restart_max_shift_m = 4.0;
