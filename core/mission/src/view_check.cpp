@@ -86,6 +86,9 @@ PointCloud visible_points(const PointCloud& map, const Eigen::Vector3f& eye, dou
     throw std::invalid_argument("view check: bin_deg must be within (0, 90] degrees, not " +
                                 std::to_string(config.bin_deg));
   }
+  if (judge && &judge->target() != &map) {
+    throw std::invalid_argument("view check: the judge must be one over the map's own points");
+  }
   RangeImage image(config.bin_deg);
   const auto max_range = static_cast<float>(max_range_m);
   // The scanner's own body and what it stands on right below it: no surface to match.

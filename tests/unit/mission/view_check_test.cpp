@@ -141,7 +141,7 @@ double predicted(const PointCloud& map) {
       .weakest_constraint;
 }
 
-TEST(VisiblePoints, RefusesBinsThatAreNoAngle) {
+TEST(VisiblePoints, RefusesBinsThatAreNoAngleAndAJudgeOfOtherPoints) {
   PointCloud map;
   add_ground(map, 5);
   ViewCheckConfig config;
@@ -149,6 +149,13 @@ TEST(VisiblePoints, RefusesBinsThatAreNoAngle) {
     config.bin_deg = bad;
     EXPECT_THROW(visible_points(map, {0, 0, 1.5f}, kVoxel, 60, config), std::invalid_argument);
   }
+  // Normals from a judge over other points would be another surface's.
+  const PointCloud other = map;
+  const AlignmentJudge judge(other);
+  EXPECT_THROW(visible_points(map, {0, 0, 1.5f}, kVoxel, 60, {}, {}, &judge),
+               std::invalid_argument);
+  const AlignmentJudge own(map);
+  EXPECT_NO_THROW(visible_points(map, {0, 0, 1.5f}, kVoxel, 60, {}, {}, &own));
 }
 
 TEST(VisiblePoints, OneLongFacadeFixesThePoseWeaklyACornerFirmly) {

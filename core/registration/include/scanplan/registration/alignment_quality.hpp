@@ -73,6 +73,8 @@ class AlignmentJudge {
   };
   std::optional<LocalShape> local_shape(const Eigen::Vector3f& q, double radius_m) const;
 
+  const PointCloud& target() const { return target_; }
+
  private:
   const PointCloud& target_;
   std::unique_ptr<detail::PointKdTree> own_tree_;
