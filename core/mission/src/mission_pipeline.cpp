@@ -488,10 +488,10 @@ double MissionPipeline::predicted_constraint(const Candidate& candidate) const {
   PointCloud target;
   target.points.reserve(map.size());
   for (const Eigen::Vector3f& p : map.points) target.points.push_back(p - floor);
-  for (Eigen::Vector3f& o : views.origins) o -= floor;
   const AlignmentJudge judge(target);
-  const PointCloud seen = visible_points(target, scanner_view().origins.front(), voxel,
-                                         m.target_radius_m, config_.view_check, views, &judge);
+  const PointCloud seen = visible_points(
+      target, scanner_view().origins.front(), voxel, m.target_radius_m, config_.view_check,
+      views.transformed(Eigen::Isometry3f(Eigen::Translation3f(-floor))), &judge);
   if (seen.empty()) return 0;
   // Every third point, as the matcher's judge first weighs its results: the weakest constraint
   // is a share of the points, and the normals cost most of the check.
